@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs rcfd's build and test dependencies from Debian 12 packages (run as root, or with sudo).
+# Every dependency of the project is named here; docker/Dockerfile installs the same list.
+set -euo pipefail
+packages=(
+  cmake ninja-build g++ pkg-config git
+  libeigen3-dev          # dense/sparse linear algebra (recurrence Gram matrix, pressure solver)
+  libhdf5-dev            # field databases and results
+  libboost-dev           # Boost.Asio / Boost.Beast for the server and client
+  nlohmann-json3-dev     # JSON
+  libvalijson-dev        # JSON Schema (draft 7) validation
+  libsqlite3-dev sqlite3 # job store
+  libcli11-dev           # command lines
+  libspdlog-dev          # logging
+  libgtest-dev libgmock-dev  # tests
+  libbenchmark-dev       # micro-benchmarks
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
