@@ -1,0 +1,181 @@
+#include "core/Svg.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "core/Errors.hpp"
+
+namespace rcfd {
+namespace {
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f", v);
+  return buf;
+}
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+std::string tickLabel(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+}  // namespace
+
+std::string Rgb::hex() const {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", r, g, b);
+  return buf;
+}
+
+Rgb colormap(double value) {
+  // Anchor points of matplotlib's viridis, linearly interpolated.
+  static const std::array<std::array<double, 3>, 9> anchors{{{68, 1, 84},
+                                                             {71, 44, 122},
+                                                             {59, 81, 139},
+                                                             {44, 113, 142},
+                                                             {33, 144, 141},
+                                                             {39, 173, 129},
+                                                             {92, 200, 99},
+                                                             {170, 220, 50},
+                                                             {253, 231, 37}}};
+  const double v = std::isfinite(value) ? std::clamp(value, 0.0, 1.0) : 0.0;
+  const double s = v * (anchors.size() - 1);
+  const std::size_t i = std::min<std::size_t>(std::size_t(s), anchors.size() - 2);
+  const double f = s - double(i);
+  Rgb c;
+  c.r = static_cast<unsigned char>(std::lround(anchors[i][0] + f * (anchors[i + 1][0] - anchors[i][0])));
+  c.g = static_cast<unsigned char>(std::lround(anchors[i][1] + f * (anchors[i + 1][1] - anchors[i][1])));
+  c.b = static_cast<unsigned char>(std::lround(anchors[i][2] + f * (anchors[i + 1][2] - anchors[i][2])));
+  return c;
+}
+
+SvgDocument::SvgDocument(double xmin, double xmax, double ymin, double ymax, double widthPx,
+                         double heightPx, double marginPx)
+    : xmin_(xmin), xmax_(xmax), ymin_(ymin), ymax_(ymax), width_(widthPx), height_(heightPx),
+      margin_(marginPx) {}
+
+double SvgDocument::px(double x) const {
+  return margin_ + (x - xmin_) / (xmax_ - xmin_) * (width_ - 2 * margin_);
+}
+double SvgDocument::py(double y) const {
+  return height_ - margin_ - (y - ymin_) / (ymax_ - ymin_) * (height_ - 2 * margin_);
+}
+
+void SvgDocument::line(double x0, double y0, double x1, double y1, const std::string& stroke,
+                       double widthPx, const std::string& dash) {
+  body_ += "<line x1=\"" + num(px(x0)) + "\" y1=\"" + num(py(y0)) + "\" x2=\"" + num(px(x1)) +
+           "\" y2=\"" + num(py(y1)) + "\" stroke=\"" + stroke + "\" stroke-width=\"" + num(widthPx) +
+           "\"" + (dash.empty() ? "" : " stroke-dasharray=\"" + dash + "\"") + "/>\n";
+}
+
+void SvgDocument::polyline(const std::vector<std::array<double, 2>>& points, const std::string& stroke,
+                           double widthPx) {
+  body_ += "<polyline fill=\"none\" stroke=\"" + stroke + "\" stroke-width=\"" + num(widthPx) +
+           "\" points=\"";
+  for (const auto& p : points) body_ += num(px(p[0])) + "," + num(py(p[1])) + " ";
+  body_ += "\"/>\n";
+}
+
+void SvgDocument::polygon(const std::vector<std::array<double, 2>>& points, const std::string& fill,
+                          const std::string& stroke, double widthPx, double opacity) {
+  body_ += "<polygon fill=\"" + fill + "\" fill-opacity=\"" + num(opacity) + "\" stroke=\"" + stroke +
+           "\" stroke-width=\"" + num(widthPx) + "\" points=\"";
+  for (const auto& p : points) body_ += num(px(p[0])) + "," + num(py(p[1])) + " ";
+  body_ += "\"/>\n";
+}
+
+void SvgDocument::rect(double x0, double y0, double x1, double y1, const std::string& fill,
+                       const std::string& stroke, double widthPx, double opacity) {
+  const double left = std::min(px(x0), px(x1)), top = std::min(py(y0), py(y1));
+  body_ += "<rect x=\"" + num(left) + "\" y=\"" + num(top) + "\" width=\"" +
+           num(std::abs(px(x1) - px(x0))) + "\" height=\"" + num(std::abs(py(y1) - py(y0))) +
+           "\" fill=\"" + fill + "\" fill-opacity=\"" + num(opacity) + "\" stroke=\"" + stroke +
+           "\" stroke-width=\"" + num(widthPx) + "\"/>\n";
+}
+
+void SvgDocument::circle(double x, double y, double radiusPx, const std::string& fill) {
+  body_ += "<circle cx=\"" + num(px(x)) + "\" cy=\"" + num(py(y)) + "\" r=\"" + num(radiusPx) +
+           "\" fill=\"" + fill + "\"/>\n";
+}
+
+void SvgDocument::text(double x, double y, const std::string& t, double sizePx,
+                       const std::string& anchor, const std::string& fill) {
+  body_ += "<text x=\"" + num(px(x)) + "\" y=\"" + num(py(y)) + "\" font-size=\"" + num(sizePx) +
+           "\" font-family=\"sans-serif\" text-anchor=\"" + anchor + "\" fill=\"" + fill + "\">" +
+           escape(t) + "</text>\n";
+}
+
+void SvgDocument::textPx(double xPx, double yPx, const std::string& t, double sizePx,
+                         const std::string& anchor) {
+  body_ += "<text x=\"" + num(xPx) + "\" y=\"" + num(yPx) + "\" font-size=\"" + num(sizePx) +
+           "\" font-family=\"sans-serif\" text-anchor=\"" + anchor + "\">" + escape(t) + "</text>\n";
+}
+
+void SvgDocument::heatmap(const std::vector<double>& values, int nx, int ny, double x0, double x1,
+                          double y0, double y1) {
+  const double dx = (x1 - x0) / nx, dy = (y1 - y0) / ny;
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      const double v = values[std::size_t(j) * nx + i];
+      if (std::isnan(v)) continue;
+      // Cells overlap by a hair so no white seams appear between them in viewers.
+      const double l = px(x0 + i * dx), r = px(x0 + (i + 1) * dx);
+      const double t = py(y0 + (j + 1) * dy), b = py(y0 + j * dy);
+      body_ += "<rect x=\"" + num(l) + "\" y=\"" + num(t) + "\" width=\"" + num(r - l + 0.3) +
+               "\" height=\"" + num(b - t + 0.3) + "\" fill=\"" + colormap(v).hex() + "\"/>\n";
+    }
+  }
+}
+
+void SvgDocument::axes(const std::string& xlabel, const std::string& ylabel, int xticks, int yticks) {
+  rect(xmin_, ymin_, xmax_, ymax_, "none", "#000", 1.0);
+  for (int i = 0; i <= xticks; ++i) {
+    const double x = xmin_ + (xmax_ - xmin_) * i / xticks;
+    body_ += "<line x1=\"" + num(px(x)) + "\" y1=\"" + num(py(ymin_)) + "\" x2=\"" + num(px(x)) +
+             "\" y2=\"" + num(py(ymin_) + 5) + "\" stroke=\"#000\"/>\n";
+    textPx(px(x), py(ymin_) + 17, tickLabel(x), 10, "middle");
+  }
+  for (int i = 0; i <= yticks; ++i) {
+    const double y = ymin_ + (ymax_ - ymin_) * i / yticks;
+    body_ += "<line x1=\"" + num(px(xmin_) - 5) + "\" y1=\"" + num(py(y)) + "\" x2=\"" +
+             num(px(xmin_)) + "\" y2=\"" + num(py(y)) + "\" stroke=\"#000\"/>\n";
+    textPx(px(xmin_) - 7, py(y) + 3, tickLabel(y), 10, "end");
+  }
+  textPx((px(xmin_) + px(xmax_)) / 2, height_ - 5, xlabel, 12, "middle");
+  body_ += "<text transform=\"translate(12," + num((py(ymin_) + py(ymax_)) / 2) +
+           ") rotate(-90)\" font-size=\"12\" font-family=\"sans-serif\" text-anchor=\"middle\">" +
+           escape(ylabel) + "</text>\n";
+}
+
+std::string SvgDocument::str() const {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << num(width_) << "\" height=\""
+      << num(height_) << "\" viewBox=\"0 0 " << num(width_) << " " << num(height_) << "\">\n"
+      << "<rect width=\"100%\" height=\"100%\" fill=\"#fff\"/>\n"
+      << body_ << "</svg>\n";
+  return out.str();
+}
+
+void SvgDocument::save(const std::string& path) const {
+  std::ofstream file(path);
+  if (!file) throw RunError("cannot write " + path);
+  file << str();
+  if (!file) throw RunError("failed writing " + path);
+}
+
+}  // namespace rcfd

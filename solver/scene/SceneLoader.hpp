@@ -1,0 +1,42 @@
+#pragma once
+/// \file SceneLoader.hpp
+/// Scenes and job files from JSON: validated against the embedded schemas (schemas/*.schema.json,
+/// valijson, draft 7), then checked for rules a schema cannot express (e.g. y_min < y_max), then turned
+/// into typed structs. Every violation is reported, each with its JSON pointer, the value and the rule,
+/// as one rcfd::InputError.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "scene/Scene.hpp"
+
+namespace rcfd {
+
+/// A job file (schemas/job.schema.json); the scene is always resolved (scene_file read and validated).
+struct JobSpec {
+  std::string kind;           ///< "database", "calibration" or "spray"
+  Scene scene;
+  std::string database;       ///< database path (CLI) or job id (server); empty for database jobs
+  double duration = 0.0;      ///< simulated seconds (spray; calibration: per D0) [s]
+  std::uint64_t seed = 1;
+  double checkpoint_interval = 60.0;  ///< simulated seconds between checkpoints [s]
+  std::vector<double> d0_values;      ///< calibration [m2/s]
+  double discard = 5.0;               ///< calibration: ignored start [s]
+  nlohmann::json source;              ///< the job document as given
+};
+
+/// Parses, validates and converts a scene. `source` names the document in messages (a file path).
+Scene loadScene(const nlohmann::json& document, const std::string& source = "scene");
+Scene loadSceneFile(const std::string& path);
+/// Parses text; malformed JSON, an empty file or a non-object is an InputError too.
+Scene loadSceneText(const std::string& text, const std::string& source = "scene");
+
+/// Job files: `scene_file` paths are resolved relative to `baseDirectory`.
+JobSpec loadJob(const nlohmann::json& document, const std::string& source = "job",
+                const std::string& baseDirectory = ".");
+JobSpec loadJobFile(const std::string& path);
+
+/// The text of an embedded schema by name ("scene", "job"); throws std::out_of_range otherwise.
+const std::string& schemaText(const std::string& name);
+
+}  // namespace rcfd
