@@ -1,0 +1,75 @@
+#pragma once
+/// \file FieldDatabase.hpp
+/// The recurrence field database (HDF5, layout in docs/formats.md and CONTRACTS.md): the scene, the
+/// grid with each cell's open fraction, dt_rec, and N frames of alpha_P, u_P and u_G as float32.
+/// Written one frame at a time (a crash leaves the frames written so far readable); read either all
+/// into RAM or through a bounded LRU frame cache.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geometry/CartesianGrid.hpp"
+
+namespace rcfd {
+
+/// One sampled state of the full simulation. Cell order: C order, x fastest; vectors interleaved (xyz).
+struct FieldFrame {
+  std::vector<float> alpha_p;  ///< alpha_P, particle volume fraction [-], one per cell
+  std::vector<float> u_p;      ///< u_P, particle velocity [m/s], 3 per cell
+  std::vector<float> u_g;      ///< u_G, gas velocity [m/s], 3 per cell
+
+  std::size_t bytes() const { return (alpha_p.size() + u_p.size() + u_g.size()) * sizeof(float); }
+};
+
+/// How frames are served: all in RAM (cacheBytes == 0) or through an LRU cache of at most cacheBytes.
+struct FrameStorage {
+  std::int64_t cacheBytes = 0;
+};
+
+struct FrameCacheStats {
+  std::int64_t hits = 0;
+  std::int64_t misses = 0;     ///< frames read from disk on demand
+  std::int64_t residentBytes = 0;
+};
+
+class FieldDatabase {
+ public:
+  /// Opens and validates a database; rcfd::InputError naming the dataset if it breaks the layout
+  /// (missing dataset, wrong shape, NaN in a frame, fewer than 3 frames, bad grid attributes).
+  static std::shared_ptr<FieldDatabase> open(const std::string& path, FrameStorage storage = {});
+
+  virtual ~FieldDatabase() = default;
+  virtual const std::string& path() const = 0;
+  virtual const CartesianGrid& grid() const = 0;
+  /// Open volume fraction of each cell [-] (/grid/fluid_fraction).
+  virtual const std::vector<float>& fluidFraction() const = 0;
+  virtual double dtRec() const = 0;  ///< sampling interval [s]
+  virtual int frameCount() const = 0;
+  virtual const std::string& sceneJson() const = 0;
+  /// Frame `index` (0 <= index < frameCount()); safe to call from several threads.
+  virtual std::shared_ptr<const FieldFrame> frame(int index) const = 0;
+  virtual FrameCacheStats cacheStats() const = 0;
+};
+
+/// Appends frames to a new database file; each append is flushed so the file stays readable.
+class FieldDatabaseWriter {
+ public:
+  FieldDatabaseWriter(const std::string& path, const CartesianGrid& grid,
+                      const std::vector<float>& fluidFraction, double dtRec,
+                      const std::string& sceneJson);
+  ~FieldDatabaseWriter();
+  FieldDatabaseWriter(const FieldDatabaseWriter&) = delete;
+  FieldDatabaseWriter& operator=(const FieldDatabaseWriter&) = delete;
+
+  void append(const FieldFrame& frame);
+  int framesWritten() const;
+  void close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rcfd
