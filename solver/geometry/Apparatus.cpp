@@ -388,6 +388,25 @@ std::optional<BoundaryHit> Apparatus::firstIntersection(const Vector3d& a, const
   return hit;
 }
 
+ReflectedMove moveWithMirrorReflection(const Apparatus& apparatus, const Vector3d& a, const Vector3d& b,
+                                       int maxBounces) {
+  ReflectedMove r;
+  Vector3d from = a, to = b;
+  while (const auto hit = apparatus.firstIntersection(from, to)) {
+    from = hit->point;
+    if (r.bounces == maxBounces) {
+      r.capped = true;
+      r.end = from;
+      return r;
+    }
+    ++r.bounces;
+    const Vector3d rest = to - hit->point;
+    to = from + rest - 2.0 * rest.dot(hit->normal) * hit->normal;
+  }
+  r.end = to;
+  return r;
+}
+
 CartesianGrid makeGrid(const Apparatus& apparatus, const GridSpec& spec) {
   std::vector<Violation> bad;
   for (int dim = 0; dim < 3; ++dim) {

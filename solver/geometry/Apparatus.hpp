@@ -141,6 +141,19 @@ class Apparatus {
   Eigen::Vector2d platesLo_ = Eigen::Vector2d::Zero(), platesHi_ = Eigen::Vector2d::Zero();
 };
 
+/// Outcome of moveWithMirrorReflection().
+struct ReflectedMove {
+  Eigen::Vector3d end = Eigen::Vector3d::Zero();  ///< final position, inside or on the boundary [m]
+  int bounces = 0;                                ///< boundary hits on the way
+  bool capped = false;  ///< stopped at the last hit point after maxBounces hits (end is still inside)
+};
+
+/// Moves a point from a towards b, mirror-reflecting the rest of the displacement at every boundary
+/// (walls, plates, inlet and outlet alike): the loop of the Apparatus file comment. `a` must be inside
+/// or on the boundary; the end point always is. Allocation-free.
+ReflectedMove moveWithMirrorReflection(const Apparatus& apparatus, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, int maxBounces = 64);
+
 /// The uniform grid of a scene over the apparatus's bounding box (cell size from the scene, rounded so
 /// that a whole number of cells spans each extent: n = max(1, round(extent / cell_size))).
 /// Throws rcfd::InputError (/grid/cell_size) for a non-positive or non-finite cell size.

@@ -280,6 +280,30 @@ TEST(ApparatusIntersection, ReflectUntilDoneNeverEndsOutside) {
   }
 }
 
+TEST(ApparatusIntersection, MoveWithMirrorReflection) {
+  const Apparatus app(test::procellSpec(true));
+  // Straight into the right wall 0.025 m beyond it: mirrored back to x = 0.125 - 0.025 (to tol).
+  auto m = moveWithMirrorReflection(app, {0.1, 0.3, 0.1}, {0.15, 0.3, 0.1});
+  EXPECT_EQ(m.bounces, 1);
+  EXPECT_FALSE(m.capped);
+  EXPECT_NEAR(m.end.x(), 0.1, 1e-8);
+  EXPECT_NEAR(m.end.y(), 0.3, 0.0);
+  // Into the corner of the side wall and z = 0 at 45 deg: two bounces, both components mirrored.
+  m = moveWithMirrorReflection(app, {0.12, 0.3, 0.005}, {0.13, 0.3, -0.005});
+  EXPECT_EQ(m.bounces, 2);
+  EXPECT_NEAR(m.end.x(), 0.12, 1e-8);
+  EXPECT_NEAR(m.end.z(), 0.005, 1e-8);
+  // A long flight bounces many times and ends inside; capped at 1 it stops at the next hit point.
+  m = moveWithMirrorReflection(app, {0.0, 0.3, 0.1}, {3.0, 0.9, 2.1});
+  EXPECT_GT(m.bounces, 10);
+  EXPECT_GE(app.signedDistance(m.end), 0.0);
+  m = moveWithMirrorReflection(app, {0.0, 0.3, 0.1}, {3.0, 0.9, 2.1}, 1);
+  EXPECT_TRUE(m.capped);
+  EXPECT_EQ(m.bounces, 1);
+  EXPECT_GE(app.signedDistance(m.end), 0.0);
+  EXPECT_LT(app.signedDistance(m.end), 1e-8);
+}
+
 TEST(ApparatusIntersection, Throughput) {
   // Not a benchmark (bench/ has those) but a guard: the tracer engine calls this per tracer per step.
   const Apparatus app(test::procellSpec(true));
