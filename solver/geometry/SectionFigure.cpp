@@ -294,6 +294,8 @@ SvgDocument drawSection(const Scene& scene) {
   doc.text(x0, yRow, "open volume " + fmt(app.openVolume() * 1e3) + " L", 11);
   yRow -= rowPx / scale;
   doc.text(x0, yRow, "spray zone volume " + fmt(zone.volume() * 1e6) + " mL", 11);
+  yRow -= rowPx / scale;
+  doc.text(x0, yRow, "  of which in the open region " + fmt(zone.volumeInside(app) * 1e6) + " mL", 11);
   return doc;
 }
 

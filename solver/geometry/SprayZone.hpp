@@ -10,6 +10,8 @@
 
 namespace rcfd {
 
+class Apparatus;
+
 class SprayZone {
  public:
   /// Throws rcfd::InputError naming /spray/spray_zone/... when the half-angle is not in (0, 90) deg,
@@ -27,6 +29,12 @@ class SprayZone {
   /// Exact volume of the truncated cone [m3], pi tan^2(a) / 3 ((y_max - y_a)^3 - (y_min - y_a)^3).
   /// The apparatus is ignored: a zone reaching through a wall keeps its full volume.
   double volume() const;
+
+  /// Volume of the part of the zone inside the apparatus's open region [m3]: exact disk-rectangle
+  /// areas per height, integrated over y by composite Simpson with `slices` steps (relative error
+  /// ~1e-8 at the default). Differs from volume() when the zone reaches through the z faces (thin
+  /// pseudo-2D slices), the V walls or the draft plates.
+  double volumeInside(const Apparatus& apparatus, int slices = 4000) const;
 
  private:
   SprayZoneSpec spec_;

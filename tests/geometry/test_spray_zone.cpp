@@ -5,6 +5,7 @@
 #include <random>
 
 #include "GeometryFixtures.hpp"
+#include "geometry/Apparatus.hpp"
 #include "geometry/SprayZone.hpp"
 
 namespace rcfd {
@@ -64,6 +65,57 @@ TEST(SprayZone, VolumeMatchesFrustumAndMonteCarlo) {
   moved.y_max = 0.11;
   EXPECT_NEAR(SprayZone(moved).volume(), zone.volume(), 1e-18);
   EXPECT_TRUE(SprayZone(moved).contains({0.03, 0.05, 0.05}));
+}
+
+/// Monte Carlo estimate of the zone's volume inside the apparatus, with its standard error.
+std::pair<double, double> monteCarloInside(const SprayZone& zone, const Apparatus& app) {
+  const auto& z = zone.spec();
+  const double r1 = zone.radiusAt(z.y_max);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  constexpr int kSamples = 2'000'000;
+  int in = 0;
+  const double yc = 0.5 * (z.y_min + z.y_max), hy = 0.5 * (z.y_max - z.y_min);
+  for (int i = 0; i < kSamples; ++i) {
+    const Vector3d p(z.apex.x() + r1 * u(rng), yc + hy * u(rng), z.apex.z() + r1 * u(rng));
+    in += zone.contains(p) && app.contains(p);
+  }
+  const double box = 2 * r1 * 2 * hy * 2 * r1, p = double(in) / kSamples;
+  return {p * box, box * std::sqrt(p * (1 - p) / kSamples)};
+}
+
+TEST(SprayZone, VolumeInsideTheApparatus) {
+  // The paper's zone lies wholly inside the unstabilised bed: the clipped volume is the full one.
+  const SprayZone zone(paperZone());
+  const Apparatus bed(test::procellSpec(false));
+  EXPECT_NEAR(zone.volumeInside(bed) / zone.volume(), 1.0, 1e-8);
+  // The plates cut into it above y = 0.0736 m; a thin slice (depth 0.02 m) cuts it in z; an apex off
+  // the axis pushes it through the V wall. Each against Monte Carlo.
+  const Apparatus plates(test::procellSpec(true));
+  const double withPlates = zone.volumeInside(plates);
+  EXPECT_LT(withPlates, zone.volume());
+  auto [mc, sigma] = monteCarloInside(zone, plates);
+  EXPECT_NEAR(withPlates, mc, 4 * sigma);
+
+  auto sliceSpec = test::procellSpec(true);
+  sliceSpec.depth = 0.02;
+  const Apparatus slice(sliceSpec);
+  SprayZoneSpec inSlice = paperZone();
+  inSlice.apex.z() = 0.01;
+  const SprayZone sliceZone(inSlice);
+  const double v = sliceZone.volumeInside(slice);
+  EXPECT_LT(v, 0.6 * sliceZone.volume());
+  std::tie(mc, sigma) = monteCarloInside(sliceZone, slice);
+  EXPECT_NEAR(v, mc, 4 * sigma);
+
+  SprayZoneSpec offAxis = paperZone();
+  offAxis.apex = Vector3d(0.05, 0.0, 0.1);
+  const SprayZone offZone(offAxis);
+  const double vo = offZone.volumeInside(bed);
+  EXPECT_LT(vo, 0.9 * offZone.volume());
+  EXPECT_GT(vo, 0.0);
+  std::tie(mc, sigma) = monteCarloInside(offZone, bed);
+  EXPECT_NEAR(vo, mc, 4 * sigma);
 }
 
 TEST(SprayZone, RefusesInvalidSpecs) {
