@@ -1,6 +1,8 @@
 #include "scene/SceneChecks.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -23,16 +25,24 @@ std::string point(const Vec3& p) { return "[" + num(p.x()) + ", " + num(p.y()) +
 
 double tanDeg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
 
-/// JSON numbers too large for a double arrive as +-inf; no rule of the schema catches them all.
-void findNonFinite(const json& value, const std::string& pointer, std::vector<Violation>& out, int depth) {
-  if (depth > 64) return;  // the schema has already refused anything this deep
-  if (value.is_number_float() && !std::isfinite(value.get<double>())) {
-    out.push_back({pointer, "number out of range (not a finite double)"});
-  } else if (value.is_object()) {
-    for (const auto& [key, member] : value.items()) findNonFinite(member, appendPointer(pointer, key), out, depth + 1);
-  } else if (value.is_array()) {
-    for (std::size_t i = 0; i < value.size(); ++i) {
-      findNonFinite(value[i], appendPointer(pointer, std::to_string(i)), out, depth + 1);
+/// Iterative, so that a document nested thousands deep cannot exhaust the stack.
+void findOutOfRange(const json& document, std::vector<Violation>& out) {
+  std::vector<std::pair<const json*, std::string>> pending{{&document, ""}};
+  while (!pending.empty()) {
+    auto [value, pointer] = std::move(pending.back());
+    pending.pop_back();
+    if (value->is_number_float() && !std::isfinite(value->get<double>())) {
+      out.push_back({pointer, "number out of range (not a finite double)"});
+    } else if (value->is_number_unsigned() &&
+               value->get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+      out.push_back({pointer, describeValue(*value) + " is beyond the largest supported integer " +
+                                  std::to_string(std::numeric_limits<std::int64_t>::max())});
+    } else if (value->is_object()) {
+      for (auto it = value->rbegin(); it != value->rend(); ++it) {
+        pending.emplace_back(&*it, appendPointer(pointer, it.key()));
+      }
+    } else if (value->is_array()) {
+      for (std::size_t i = value->size(); i-- > 0;) pending.emplace_back(&(*value)[i], appendPointer(pointer, std::to_string(i)));
     }
   }
 }
@@ -90,11 +100,14 @@ void apparatusBounds(const ApparatusSpec& a, Vec3& lower, Vec3& upper) {
   }
 }
 
+std::vector<Violation> numberRangeViolations(const json& document) {
+  std::vector<Violation> out;
+  findOutOfRange(document, out);
+  return out;
+}
+
 std::vector<Violation> checkSceneSemantics(const Scene& s, const json& document) {
   std::vector<Violation> out;
-  findNonFinite(document, "", out, 0);
-  if (!out.empty()) return out;  // the relations below would only repeat these
-
   checkApparatus(s.apparatus, out);
   Vec3 lower, upper;
   apparatusBounds(s.apparatus, lower, upper);

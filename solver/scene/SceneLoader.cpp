@@ -41,6 +41,11 @@ json parseText(const std::string& text, const std::string& source, const char* w
       message = message.substr(tag + 2);
     }
     throw InputError(source, "", "malformed JSON: " + message);
+  } catch (const json::exception& e) {
+    // e.g. out_of_range 406: a number beyond the range of a double ("1e400").
+    std::string message = e.what();
+    if (const auto tag = message.find("] "); tag != std::string::npos) message = message.substr(tag + 2);
+    throw InputError(source, "", "malformed JSON: " + message + (e.id == 406 ? " (beyond the range of a double)" : ""));
   }
 }
 
@@ -76,7 +81,9 @@ Scene convertScene(const json& document, std::vector<Violation>& violations) {
 
 Scene loadScene(const json& document, const std::string& source) {
   requireObject(document, source, "a scene");
-  auto violations = SchemaValidator::get("scene").validate(document);
+  auto violations = numberRangeViolations(document);
+  if (!violations.empty()) throw InputError(source, std::move(violations));
+  violations = SchemaValidator::get("scene").validate(document);
   if (!violations.empty()) throw InputError(source, std::move(violations));
   Scene scene = convertScene(document, violations);
   if (!violations.empty()) throw InputError(source, std::move(violations));
@@ -94,7 +101,9 @@ Scene loadSceneFile(const std::string& path) { return loadSceneText(readFile(pat
 
 JobSpec loadJob(const json& document, const std::string& source, const std::string& baseDirectory) {
   requireObject(document, source, "a job");
-  auto violations = SchemaValidator::get("job").validate(document);
+  auto violations = numberRangeViolations(document);
+  if (!violations.empty()) throw InputError(source, std::move(violations));
+  violations = SchemaValidator::get("job").validate(document);
   if (!violations.empty()) throw InputError(source, std::move(violations));
 
   JobSpec job;

@@ -248,7 +248,12 @@ void SchemaExplainer::checkObject(const json& schema, const Context& ctx, const 
         if (props != schema.end()) {
           for (const auto& [name, unused] : props->items()) allowed.push_back(name);
         }
-        out.push_back({memberPointer, "unknown key \"" + key + "\"; allowed here: " +
+        // Within a typed variant (apparatus "box" or "prismatic_spouted_bed") name the variant.
+        std::string variant;
+        if (props != schema.end() && props->contains("type") && (*props)["type"].contains("const")) {
+          variant = " for type " + describeValue((*props)["type"]["const"]);
+        }
+        out.push_back({memberPointer, "unknown key \"" + key + "\"" + variant + "; allowed here: " +
                                           quotedList(allowed) + " (additionalProperties)"});
       } else {
         check(*additional, ctx, member, memberPointer, out, depth + 1);
