@@ -60,6 +60,7 @@ std::string mutate(const std::string& text, std::mt19937_64& rng) {
       static const json replacements[] = {1e308, -1e308, 0, -1, 1, 0.5, 1e-300, "NaN", "", true, nullptr,
                                           json::array(), json::object(), 18446744073709551615ull,
                                           -9223372036854775807LL - 1, json::array({1, 2, 3})};
+      bool compact = pick(2) == 0;
       switch (pick(5)) {
         case 0: {
           json va = doc[a], vb = doc[b];  // copies: one pointer may lie inside the other's value
@@ -73,6 +74,7 @@ std::string mutate(const std::string& text, std::mt19937_64& rng) {
           const std::size_t depth = 1 + pick(2000);
           for (std::size_t i = 0; i < depth; ++i) nested = json::array({std::move(nested)});
           doc[a] = std::move(nested);
+          compact = true;  // indented, 2000 levels would be megabytes of blanks
           break;
         }
         case 3: doc.erase(doc.begin()); break;
@@ -83,7 +85,7 @@ std::string mutate(const std::string& text, std::mt19937_64& rng) {
           break;
         }
       }
-      t = doc.dump(pick(2) ? 2 : -1);
+      t = doc.dump(compact ? -1 : 2);
       if (pick(4) == 0) {  // a number too large for a double, as text
         const auto digit = t.find_first_of("123456789");
         if (digit != std::string::npos) t.insert(digit + 1, "e400");
