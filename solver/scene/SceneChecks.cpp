@@ -26,24 +26,39 @@ std::string point(const Vec3& p) { return "[" + num(p.x()) + ", " + num(p.y()) +
 double tanDeg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
 
 /// Iterative, so that a document nested thousands deep cannot exhaust the stack.
-void findOutOfRange(const json& document, std::vector<Violation>& out) {
-  std::vector<std::pair<const json*, std::string>> pending{{&document, ""}};
+void findLimitViolations(const json& document, std::vector<Violation>& out) {
+  struct Item {
+    const json* value;
+    std::string pointer;
+    int depth;
+  };
+  std::vector<Item> pending{{&document, "", 0}};
   while (!pending.empty()) {
-    auto [value, pointer] = std::move(pending.back());
+    Item item = std::move(pending.back());
     pending.pop_back();
-    if (value->is_number_float() && !std::isfinite(value->get<double>())) {
-      out.push_back({pointer, "number out of range (not a finite double)"});
-    } else if (value->is_number_unsigned() &&
-               value->get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
-      out.push_back({pointer, describeValue(*value) + " is beyond the largest supported integer " +
-                                  std::to_string(std::numeric_limits<std::int64_t>::max())});
-    } else if (value->is_object()) {
-      for (auto it = value->rbegin(); it != value->rend(); ++it) {
-        pending.emplace_back(&*it, appendPointer(pointer, it.key()));
+    const json& value = *item.value;
+    if (value.is_number_float() && !std::isfinite(value.get<double>())) {
+      out.push_back({item.pointer, "number out of range (not a finite double)"});
+    } else if (value.is_number_unsigned() &&
+               value.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+      out.push_back({item.pointer, describeValue(value) + " is beyond the largest supported integer " +
+                                       std::to_string(std::numeric_limits<std::int64_t>::max())});
+    } else if (value.is_structured() && item.depth >= kMaxDocumentDepth) {
+      out.push_back({item.pointer, "nested deeper than " + std::to_string(kMaxDocumentDepth) +
+                                       " levels; no scene or job key is nested like this"});
+    } else if (value.is_array() && value.size() > kMaxArrayItems) {
+      out.push_back({item.pointer, "array of " + std::to_string(value.size()) + " items is longer than the " +
+                                       std::to_string(kMaxArrayItems) + " allowed"});
+    } else if (value.is_object()) {
+      for (auto it = value.rbegin(); it != value.rend(); ++it) {
+        pending.push_back({&*it, appendPointer(item.pointer, it.key()), item.depth + 1});
       }
-    } else if (value->is_array()) {
-      for (std::size_t i = value->size(); i-- > 0;) pending.emplace_back(&(*value)[i], appendPointer(pointer, std::to_string(i)));
+    } else if (value.is_array()) {
+      for (std::size_t i = value.size(); i-- > 0;) {
+        pending.push_back({&value[i], appendPointer(item.pointer, std::to_string(i)), item.depth + 1});
+      }
     }
+    if (out.size() >= 20) return;  // enough to fix the document; do not flood
   }
 }
 
@@ -100,9 +115,9 @@ void apparatusBounds(const ApparatusSpec& a, Vec3& lower, Vec3& upper) {
   }
 }
 
-std::vector<Violation> numberRangeViolations(const json& document) {
+std::vector<Violation> documentLimitViolations(const json& document) {
   std::vector<Violation> out;
-  findOutOfRange(document, out);
+  findLimitViolations(document, out);
   return out;
 }
 

@@ -16,9 +16,13 @@ namespace rcfd {
 /// tell given values from defaults); pointers are relative to the scene document.
 std::vector<Violation> checkSceneSemantics(const Scene& scene, const nlohmann::json& document);
 
-/// Numbers no rule can judge: doubles that are not finite and integers beyond int64 (valijson reads
-/// those as negative). Checked before the schema, for scenes and job files alike.
-std::vector<Violation> numberRangeViolations(const nlohmann::json& document);
+/// Limits checked before the schema, for scenes and job files alike: nesting deeper than
+/// kMaxDocumentDepth and arrays longer than kMaxArrayItems (the recursive and quadratic parts of any
+/// validator would otherwise let one request exhaust the stack or the CPU), doubles that are not
+/// finite and integers beyond int64 (valijson reads those as negative).
+inline constexpr int kMaxDocumentDepth = 32;
+inline constexpr std::size_t kMaxArrayItems = 100000;
+std::vector<Violation> documentLimitViolations(const nlohmann::json& document);
 
 /// Lower and upper corner of the apparatus's bounding box (CONTRACTS.md coordinates) [m].
 void apparatusBounds(const ApparatusSpec& apparatus, Vec3& lower, Vec3& upper);

@@ -81,9 +81,7 @@ Scene convertScene(const json& document, std::vector<Violation>& violations) {
 
 Scene loadScene(const json& document, const std::string& source) {
   requireObject(document, source, "a scene");
-  auto violations = numberRangeViolations(document);
-  if (!violations.empty()) throw InputError(source, std::move(violations));
-  violations = SchemaValidator::get("scene").validate(document);
+  auto violations = SchemaValidator::get("scene").validate(document);
   if (!violations.empty()) throw InputError(source, std::move(violations));
   Scene scene = convertScene(document, violations);
   if (!violations.empty()) throw InputError(source, std::move(violations));
@@ -101,9 +99,7 @@ Scene loadSceneFile(const std::string& path) { return loadSceneText(readFile(pat
 
 JobSpec loadJob(const json& document, const std::string& source, const std::string& baseDirectory) {
   requireObject(document, source, "a job");
-  auto violations = numberRangeViolations(document);
-  if (!violations.empty()) throw InputError(source, std::move(violations));
-  violations = SchemaValidator::get("job").validate(document);
+  auto violations = SchemaValidator::get("job").validate(document);
   if (!violations.empty()) throw InputError(source, std::move(violations));
 
   JobSpec job;

@@ -99,14 +99,42 @@ std::string appendPointer(const std::string& pointer, const std::string& token) 
   return pointer + "/" + escaped;
 }
 
-std::string describeValue(const json& value, std::size_t maxLength) {
-  if (value.is_number_float()) return formatNumber(value.get<double>());
-  std::string text;
-  try {
-    text = value.dump(-1, ' ', false, json::error_handler_t::replace);
-  } catch (const std::exception&) {
-    text = typeName(value);
+namespace {
+/// Compact JSON text, stopping once `budget` characters are written (no recursion past that).
+void render(const json& value, std::string& text, std::size_t budget, int depth) {
+  if (text.size() > budget) return;
+  if (depth > 8) {
+    text += value.is_array() ? "[...]" : "{...}";
+    return;
   }
+  if (value.is_array()) {
+    text += '[';
+    for (std::size_t i = 0; i < value.size() && text.size() <= budget; ++i) {
+      if (i) text += ',';
+      render(value[i], text, budget, depth + 1);
+    }
+    text += ']';
+  } else if (value.is_object()) {
+    text += '{';
+    bool first = true;
+    for (auto it = value.begin(); it != value.end() && text.size() <= budget; ++it) {
+      if (!first) text += ',';
+      first = false;
+      text += json(it.key()).dump(-1, ' ', false, json::error_handler_t::replace) + ':';
+      render(it.value(), text, budget, depth + 1);
+    }
+    text += '}';
+  } else if (value.is_number_float()) {
+    text += formatNumber(value.get<double>());
+  } else {
+    text += value.dump(-1, ' ', false, json::error_handler_t::replace);
+  }
+}
+}  // namespace
+
+std::string describeValue(const json& value, std::size_t maxLength) {
+  std::string text;
+  render(value, text, maxLength, 0);
   if (text.size() > maxLength) text = text.substr(0, maxLength) + "...";
   return text;
 }

@@ -10,6 +10,7 @@
 #include <valijson/validator.hpp>
 
 #include "core/EmbeddedFiles.hpp"
+#include "scene/SceneChecks.hpp"
 #include "scene/SchemaExplainer.hpp"
 
 namespace rcfd {
@@ -89,6 +90,7 @@ bool SchemaValidator::conforms(const nlohmann::json& document, std::vector<Viola
 }
 
 std::vector<Violation> SchemaValidator::validate(const nlohmann::json& document) const {
+  if (auto limits = documentLimitViolations(document); !limits.empty()) return limits;
   std::vector<Violation> raw;
   if (conforms(document, &raw)) return {};
 

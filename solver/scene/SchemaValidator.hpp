@@ -23,7 +23,8 @@ class SchemaValidator {
   /// Throws std::out_of_range for an unknown name.
   static const SchemaValidator& get(const std::string& name);
 
-  /// Every violation of the schema; empty if the document conforms.
+  /// Every violation of the schema; empty if the document conforms. Documents beyond the limits of
+  /// documentLimitViolations() (SceneChecks.hpp) get those violations and are not validated further.
   std::vector<Violation> validate(const nlohmann::json& document) const;
 
   /// valijson's own verdict and its raw errors (pointer, valijson's text), for tests and fallback.

@@ -151,3 +151,35 @@ TEST(BadScenes, TextEdgeCasesAreInputErrors) {
 TEST(BadScenes, MissingFileIsAnInputError) {
   EXPECT_THROW(loadSceneFile(sourcePath("tests/data/no-such-scene.json")), InputError);
 }
+
+TEST(BadScenes, DocumentLimitsAreEnforcedBeforeTheSchema) {
+  // 100,000 levels of nesting: refused with a pointer, without exhausting the stack.
+  const std::string deep = "{\"apparatus\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  try {
+    loadSceneText(deep, "deep");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.violations().size(), 1u) << e.what();
+    EXPECT_NE(e.violations()[0].message.find("nested deeper"), std::string::npos);
+    EXPECT_EQ(e.violations()[0].pointer.rfind("/apparatus/0/0/", 0), 0u);
+  }
+  // A long effects list would make uniqueItems quadratic.
+  auto doc = nlohmann::json::parse(readText(sourcePath("examples/quick.json")));
+  doc["effects"] = nlohmann::json::array();
+  for (int i = 0; i < 100001; ++i) doc["effects"].push_back("gas");
+  try {
+    loadScene(doc, "long");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations().at(0).pointer, "/effects");
+  }
+  doc = nlohmann::json::parse(readText(sourcePath("examples/quick.json")));
+  doc["rcfd"]["tracers"] = 18446744073709551615ull;  // valijson would read this as -1
+  try {
+    loadScene(doc, "big");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations().at(0).pointer, "/rcfd/tracers");
+    EXPECT_NE(e.violations()[0].message.find("beyond the largest supported integer"), std::string::npos);
+  }
+}
