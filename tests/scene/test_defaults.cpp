@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
+
 #include "scene/SceneJson.hpp"
 #include "core/Errors.hpp"
 #include "scene/SceneLoader.hpp"
@@ -39,16 +42,11 @@ bool sameNumberOrValue(const json& a, const json& b) {
   return a == b;
 }
 
-}  // namespace
-
-// Each "default" of the schema equals the C++ initializer: a scene that gives only what is required
-// loads into exactly the schema's defaults.
-TEST(Defaults, SchemaDefaultsEqualCppDefaults) {
-  const json& schema = SchemaValidator::get("scene").schema();
+/// Pointers whose schema "default" differs from the C++ initializer (or has no typed counterpart):
+/// a scene that gives only what is required loads into exactly the schema's defaults.
+std::vector<std::string> defaultMismatches(const json& schema, std::size_t* compared) {
   std::map<std::string, json> defaults;
   collectDefaults(schema, schema, "", defaults);
-  ASSERT_GT(defaults.size(), 60u);
-
   const json prismatic = {{"apparatus", {{"type", "prismatic_spouted_bed"}, {"draft_plates", json::object()}}},
                           {"grid", json::object()}, {"gas", json::object()}, {"particles", json::object()},
                           {"process", json::object()}, {"effects", json::array()}};
@@ -56,31 +54,54 @@ TEST(Defaults, SchemaDefaultsEqualCppDefaults) {
   box["apparatus"] = {{"type", "box"}};
   const json loaded[] = {sceneToJson(loadScene(prismatic)), sceneToJson(loadScene(box))};
 
-  int compared = 0;
+  std::vector<std::string> mismatches;
+  *compared = 0;
   for (const auto& [pointer, value] : defaults) {
-    SCOPED_TRACE(pointer);
-    bool found = false;
+    const json::json_pointer p(pointer);
+    const json* actual = nullptr;
     for (const auto& doc : loaded) {
-      const json::json_pointer p(pointer);
-      if (!doc.contains(p)) continue;
-      found = true;
-      const json& actual = doc.at(p);
-      if (pointer == "/grid/cell_size" && value.is_number()) {
-        for (const auto& c : actual) EXPECT_TRUE(sameNumberOrValue(c, value)) << actual << " vs " << value;
-      } else if (pointer == "/apparatus/type") {
-        EXPECT_EQ(loaded[0].at(p), value);
-      } else {
-        EXPECT_TRUE(sameNumberOrValue(actual, value) ||
-                    (actual.is_array() && value.is_array() && actual.size() == value.size() &&
-                     std::equal(actual.begin(), actual.end(), value.begin(), sameNumberOrValue)))
-            << "C++ " << actual << " vs schema " << value;
+      if (doc.contains(p)) {
+        actual = &doc.at(p);
+        break;
       }
-      ++compared;
-      break;
     }
-    EXPECT_TRUE(found) << "schema default with no counterpart in the typed scene";
+    if (!actual) {
+      mismatches.push_back(pointer + " (no counterpart in the typed scene)");
+      continue;
+    }
+    ++*compared;
+    bool same;
+    if (pointer == "/grid/cell_size" && value.is_number()) {
+      same = std::all_of(actual->begin(), actual->end(), [&](const json& c) { return sameNumberOrValue(c, value); });
+    } else if (actual->is_array() && value.is_array()) {
+      same = actual->size() == value.size() && std::equal(actual->begin(), actual->end(), value.begin(), sameNumberOrValue);
+    } else {
+      same = sameNumberOrValue(*actual, value);
+    }
+    if (!same) mismatches.push_back(pointer + ": C++ " + actual->dump() + ", schema " + value.dump());
   }
-  EXPECT_EQ(compared, static_cast<int>(defaults.size()));
+  return mismatches;
+}
+
+}  // namespace
+
+TEST(Defaults, SchemaDefaultsEqualCppDefaults) {
+  std::size_t compared = 0;
+  const auto mismatches = defaultMismatches(SchemaValidator::get("scene").schema(), &compared);
+  EXPECT_TRUE(mismatches.empty()) << ::testing::PrintToString(mismatches);
+  EXPECT_GT(compared, 60u);
+}
+
+// The comparison itself can fail: a schema whose default drifted from the C++ value is caught.
+TEST(Defaults, DriftedDefaultIsDetected) {
+  json drifted = SchemaValidator::get("scene").schema();
+  drifted["properties"]["particles"]["properties"]["diameter"]["default"] = 2.0e-3;
+  drifted["definitions"]["draft_plates"]["properties"]["elevation"]["default"] = 0.01;
+  std::size_t compared = 0;
+  const auto mismatches = defaultMismatches(drifted, &compared);
+  ASSERT_EQ(mismatches.size(), 2u) << ::testing::PrintToString(mismatches);
+  EXPECT_EQ(mismatches[0].rfind("/apparatus/draft_plates/elevation", 0), 0u);
+  EXPECT_EQ(mismatches[1].rfind("/particles/diameter", 0), 0u);
 }
 
 TEST(Defaults, MinimalSceneLoads) {
