@@ -251,6 +251,11 @@ void SchemaExplainer::check(const json& schemaIn, const Context& ctxIn, const js
     }
   }
   if (schema.contains("oneOf")) checkOneOf(schema, ctx, value, pointer, out, depth);
+  if (auto n = schema.find("not"); n != schema.end() && matches(*n, ctx, value, depth)) {
+    // "x-message" lets a schema say why, e.g. which kind of job takes a key.
+    out.push_back({pointer, schema.value("x-message", describeValue(value) + " matches a schema it must not") +
+                                " (not)"});
+  }
 }
 
 void SchemaExplainer::checkObject(const json& schema, const Context& ctx, const json& value,
@@ -347,8 +352,8 @@ void SchemaExplainer::checkOneOf(const json& schema, const Context& ctx, const j
     for (const json* b : resolved) {
       names.push_back((*b)["const"].is_string() ? (*b)["const"].get<std::string>() : (*b)["const"].dump());
     }
-    // The effect vocabulary is the one const list users meet most; name it as such.
-    const bool effect = pointer.rfind("/effects/", 0) == 0;
+    // The effect vocabulary (its entries carry "x-stage") is the const list users meet most.
+    const bool effect = resolved.front()->contains("x-stage");
     std::string text = effect ? "unknown effect " : "unknown value ";
     text += describeValue(value) + "; valid " + (effect ? "effects" : "values") + " are: ";
     for (std::size_t i = 0; i < names.size(); ++i) text += (i ? ", " : "") + names[i];

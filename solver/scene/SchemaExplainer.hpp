@@ -6,7 +6,8 @@
 /// the JSON pointer, the offending value and the rule: `/spray/cone_half_angle_deg: 95 is not < 90
 /// (exclusiveMaximum)`. It covers the keywords rcfd's schemas use: $ref, type, enum, const, minimum,
 /// maximum, exclusiveMinimum, exclusiveMaximum, minLength, minItems, maxItems, uniqueItems, items,
-/// properties, additionalProperties, required, if/then/else, allOf, oneOf and boolean schemas.
+/// properties, additionalProperties, required, if/then/else, allOf, oneOf, not and boolean schemas. A
+/// schema may word its `not` violation itself with the extension keyword "x-message".
 
 #include <functional>
 #include <nlohmann/json.hpp>

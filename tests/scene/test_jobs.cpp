@@ -95,3 +95,17 @@ TEST(Jobs, SchemaTextsAreServed) {
   EXPECT_NE(schemaText("job").find("\"scene_file\""), std::string::npos);
   EXPECT_THROW(schemaText("nonsense"), std::out_of_range);
 }
+
+TEST(Jobs, MessagesSayWhatIsWrong) {
+  json scene = quickScene();
+  scene["effects"].push_back("bogus");
+  try {
+    loadJob({{"kind", "spray"}, {"scene", scene}, {"database", "d"}, {"duration", 1.0}, {"discard", 2.0}}, "job");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.violations().size(), 2u) << e.what();
+    const std::string text = e.what();
+    EXPECT_NE(text.find("/discard: only calibration jobs take \"discard\" (not)"), std::string::npos) << text;
+    EXPECT_NE(text.find("/scene/effects/16: unknown effect \"bogus\""), std::string::npos) << text;
+  }
+}
