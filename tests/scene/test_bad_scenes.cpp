@@ -136,6 +136,13 @@ TEST(BadScenes, ExplainerAgreesWithValijson) {
     if (!conforms) {
       EXPECT_FALSE(validator.validate(doc).empty()) << bad.file;
       ++compared;
+      // valijson's context, as a JSON pointer, is the expected pointer or (for required and
+      // additionalProperties, which valijson reports on the object) its parent.
+      const std::string expected = bad.pointer;
+      const std::string parent = expected.substr(0, expected.rfind('/'));
+      bool located = false;
+      for (const auto& v : raw) located = located || v.pointer == expected || v.pointer == parent;
+      EXPECT_TRUE(located) << bad.file << ": no valijson error at " << expected;
     }
   }
   EXPECT_GE(compared, 15);
