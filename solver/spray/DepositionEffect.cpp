@@ -66,7 +66,7 @@ class DepositionEffect final : public TracerEffect {
     s.parcelDeposit.assign(std::size_t(n), 0.0);
     s.parcelCell.assign(std::size_t(n), 0);
     const FrameSampler sampler = ctx.sampler();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
     for (std::int64_t j = 0; j < n; ++j) {
       const Eigen::Vector3d p = pc.position(std::size_t(j));
       const auto cell = std::int32_t(ctx.grid.flatIndexOf(p));

@@ -22,7 +22,7 @@ class DepositionMapsEffect final : public TracerEffect {
     if (!ctx.collecting()) return;
     const auto& dep = state_->cellDeposit;
     const std::int64_t n = std::int64_t(sum_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
     for (std::int64_t c = 0; c < n; ++c) sum_[std::size_t(c)] += dep[std::size_t(c)];
     ++samples_;
   }

@@ -17,6 +17,10 @@
 
 namespace rcfd {
 
+/// Loops shorter than this run on one thread: a parallel region costs a few microseconds of fork and
+/// barrier, more than a short loop's work (and spinning threads hurt most on a loaded machine).
+inline constexpr std::int64_t kParallelThreshold = 4096;
+
 struct SprayState;  // solver/spray/SprayState.hpp: parcels, balances, droplets per tracer
 
 struct TracerContext {

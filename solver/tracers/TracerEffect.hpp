@@ -32,6 +32,7 @@ struct MotionSettings {
   double uFlucMax = 1.0;         ///< [m/s]
   double freeFlightAlpha = 0.02; ///< [-]
   double maxCourant = 1.0;       ///< particle Courant bound for sub-steps [-]
+  bool midpoint = true;          ///< Eq. (9) by the midpoint rule (2nd order) instead of Euler
   double wallRestitution = 0.75; ///< normal restitution of free-flying tracers at walls [-]
 };
 

@@ -107,7 +107,7 @@ void TracerSimulation::placeTracers() {
   const std::int64_t n = std::int64_t(cloud_.size());
   const auto& grid = ctx.grid;
   std::int64_t failures = 0;
-#pragma omp parallel for schedule(static) reduction(+ : failures)
+#pragma omp parallel for schedule(static) reduction(+ : failures) if (n > kParallelThreshold)
   for (std::int64_t i = 0; i < n; ++i) {
     CounterRng rng(settings_.seed, RngPurpose::Initialisation, std::uint64_t(i), 0);
     bool placed = false;

@@ -19,7 +19,7 @@ class FieldAverageEffect final : public TracerEffect {
     if (!ctx.collecting()) return;
     const FrameSampler sampler = ctx.sampler();
     const std::int64_t cells = std::int64_t(tracerSum_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (cells > kParallelThreshold)
     for (std::int64_t c = 0; c < cells; ++c) {
       tracerSum_[std::size_t(c)] += ctx.tracerAlpha[std::size_t(c)];
       recurrenceSum_[std::size_t(c)] += sampler.alphaP(c);

@@ -2,6 +2,7 @@
 // transport (Eq. 9), fluctuation (Eq. 10), free_flight and walls.
 #include <memory>
 
+#include "core/Errors.hpp"
 #include "tracers/FluctuationModel.hpp"
 #include "tracers/TracerEffect.hpp"
 
@@ -10,14 +11,22 @@ namespace {
 
 class TransportEffect final : public TracerEffect {
  public:
-  explicit TransportEffect(const TracerContext& ctx) : maxCourant_(ctx.scene.rcfd.max_courant) {}
+  explicit TransportEffect(const TracerContext& ctx)
+      : maxCourant_(ctx.scene.rcfd.max_courant), midpoint_(ctx.scene.rcfd.integrator != "euler") {
+    if (ctx.scene.rcfd.integrator != "euler" && ctx.scene.rcfd.integrator != "midpoint") {
+      throw InputError("scene", "/rcfd/integrator",
+                       "unknown integrator \"" + ctx.scene.rcfd.integrator + "\"; valid: euler midpoint");
+    }
+  }
   void configureMotion(MotionSettings& m) override {
     m.transport = true;
     m.maxCourant = maxCourant_;
+    m.midpoint = midpoint_;
   }
 
  private:
   double maxCourant_;
+  bool midpoint_;
 };
 
 class FluctuationEffect final : public TracerEffect {

@@ -34,7 +34,7 @@ class ResidenceTimeEffect final : public TracerEffect {
     const std::int64_t discard = ctx.discardSteps;
     std::int64_t inside = 0;
     std::vector<std::int64_t> finished;  // durations in steps of stays ending now
-#pragma omp parallel
+#pragma omp parallel if (n > kParallelThreshold)
     {
       std::vector<std::int64_t> local;
 #pragma omp for schedule(static) reduction(+ : inside)

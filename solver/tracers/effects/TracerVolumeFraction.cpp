@@ -24,7 +24,7 @@ class TracerVolumeFractionEffect final : public TracerEffect {
     auto& count = ctx.tracerCount;
     std::fill(count.begin(), count.end(), 0);
     const std::int64_t n = std::int64_t(cloud.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
     for (std::int64_t i = 0; i < n; ++i) {
       const auto c = std::int32_t(ctx.grid.flatIndexOf(cloud.position(std::size_t(i))));
       ctx.tracerCell[std::size_t(i)] = c;
@@ -33,7 +33,7 @@ class TracerVolumeFractionEffect final : public TracerEffect {
     }
     const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
     const std::int64_t cells = ctx.grid.cellCount();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (cells > kParallelThreshold)
     for (std::int64_t c = 0; c < cells; ++c) {
       const double open = ctx.openVolume[std::size_t(c)];
       ctx.tracerAlpha[std::size_t(c)] =
