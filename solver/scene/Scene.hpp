@@ -130,6 +130,7 @@ struct RcfdSpec {
   double free_flight_alpha = 0.02;  ///< free flight where alpha_P^rec is below this [-]
   std::string fluctuation_model = "lichtenegger_pirker";  ///< or "cfdem"
   double max_courant = 1.0;         ///< particle Courant number bound for sub-stepping [-]
+  std::string integrator = "midpoint";  ///< Eq. (9) time integration: "midpoint" (2nd order) or "euler"
   long frame_cache_bytes = 0;       ///< 0: load all frames into RAM; else LRU cache size [bytes]
   PathSpec path;
 };
