@@ -141,6 +141,33 @@ void SvgDocument::heatmap(const std::vector<double>& values, int nx, int ny, dou
   }
 }
 
+void SvgDocument::heatmapRuns(const std::vector<double>& values, int nx, int ny, double x0, double x1,
+                              double y0, double y1, int levels) {
+  const double dx = (x1 - x0) / nx, dy = (y1 - y0) / ny;
+  levels = std::max(2, levels);
+  auto level = [&](double v) {
+    return std::isnan(v) ? -1 : int(std::lround(std::clamp(v, 0.0, 1.0) * (levels - 1)));
+  };
+  body_ += "<g shape-rendering=\"crispEdges\">\n";
+  for (int j = 0; j < ny; ++j) {
+    int i = 0;
+    while (i < nx) {
+      const int l = level(values[std::size_t(j) * nx + i]);
+      int end = i + 1;
+      while (end < nx && level(values[std::size_t(j) * nx + end]) == l) ++end;
+      if (l >= 0) {
+        const double left = px(x0 + i * dx), right = px(x0 + end * dx);
+        const double top = py(y0 + (j + 1) * dy), bottom = py(y0 + j * dy);
+        body_ += "<rect x=\"" + num(left) + "\" y=\"" + num(top) + "\" width=\"" + num(right - left + 0.3) +
+                 "\" height=\"" + num(bottom - top + 0.3) + "\" fill=\"" +
+                 colormap(double(l) / (levels - 1)).hex() + "\"/>\n";
+      }
+      i = end;
+    }
+  }
+  body_ += "</g>\n";
+}
+
 void SvgDocument::axes(const std::string& xlabel, const std::string& ylabel, int xticks, int yticks) {
   rect(xmin_, ymin_, xmax_, ymax_, "none", "#000", 1.0);
   for (int i = 0; i <= xticks; ++i) {

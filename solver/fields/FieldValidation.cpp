@@ -7,6 +7,8 @@ namespace rcfd {
 
 namespace {
 std::string str(double v) {
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "+Inf" : "-Inf";
   std::ostringstream out;
   out.precision(9);
   out << v;

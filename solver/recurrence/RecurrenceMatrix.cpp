@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 
 #include "core/Errors.hpp"
 #include "fields/Hdf5.hpp"
@@ -76,19 +77,28 @@ std::vector<Tile> tiles(int first, int count, int size) {
   return out;
 }
 
-// Fetches frames [first, first + count) into columns, transformed by `store(column, values)`.
+// Fetches frames [first, first + count) into columns, transformed by `store(column, values)`. A frame
+// that fails to load (e.g. NaN found by a cached database) throws after the parallel loop: exceptions
+// must not leave an OpenMP region.
 template <class Store>
 void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
   const std::size_t cells = s.weights.size();
+  std::exception_ptr failure;
 #pragma omp parallel
   {
     std::vector<float> buffer(cells);
 #pragma omp for schedule(dynamic, 1)
     for (int f = 0; f < count; ++f) {
-      s.fetch(first + f, buffer.data());
-      store(f, buffer);
+      try {
+        s.fetch(first + f, buffer.data());
+        store(f, buffer);
+      } catch (...) {
+#pragma omp critical(rcfd_recurrence_failure)
+        if (!failure) failure = std::current_exception();
+      }
     }
   }
+  if (failure) std::rethrow_exception(failure);
 }
 
 // Gram form of the L2 distances. Frames are centred on frame 0 (D is unchanged, (a_i - r) - (a_j - r)

@@ -92,6 +92,22 @@ SamplingReport samplingCriterion(const FieldDatabase& db, const std::string& fie
   return report;
 }
 
+double samplingBound(const std::vector<double>& gamma, double dt) {
+  if (gamma.size() < 3) {
+    throw InputError("sampling criterion", "gamma", std::to_string(gamma.size()) + " samples; at least 3 are needed");
+  }
+  if (!(std::isfinite(dt) && dt > 0.0)) {
+    throw InputError("sampling criterion", "dt", std::to_string(dt) + " must be finite and > 0 [s]");
+  }
+  double square = 0.0, rateSquare = 0.0;
+  for (std::size_t n = 1; n + 1 < gamma.size(); ++n) {
+    const double rate = (gamma[n + 1] - gamma[n - 1]) / (2.0 * dt);
+    square += gamma[n] * gamma[n];
+    rateSquare += rate * rate;
+  }
+  return rateSquare > 0.0 ? std::sqrt(square / rateSquare) : std::numeric_limits<double>::infinity();  // Eq. (8)
+}
+
 std::vector<SamplingProbe> probesFromSceneJson(const std::string& sceneJson) {
   std::vector<SamplingProbe> out;
   const auto doc = nlohmann::json::parse(sceneJson, nullptr, false);
