@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <type_traits>
 
 #include "core/Errors.hpp"
 #include "fields/Hdf5.hpp"
@@ -103,7 +104,13 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
 
 // Gram form of the L2 distances. Frames are centred on frame 0 (D is unchanged, (a_i - r) - (a_j - r)
 // = a_i - a_j) so n_i + n_j - 2 G_ij cancels less, then scaled by sqrt(V_c): G_ij = sum_c V_c x_i x_j.
+// Scalar = double: one double GEMM per tile pair. Scalar = float: float GEMMs over chunks of
+// `floatChunk` cells, each chunk's partial sums added in double, so rounding grows with the chunk, not
+// with the cell count (docs/performance.md compares both).
+template <class Scalar>
 Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileFrames, std::int64_t* clamped) {
+  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  constexpr Eigen::Index floatChunk = 2048;
   const int n = s.frames;
   const Eigen::Index cells = Eigen::Index(s.weights.size());
   std::vector<float> reference(s.weights.size());
@@ -111,37 +118,52 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
   Eigen::VectorXd sqrtW(cells);
   for (Eigen::Index c = 0; c < cells; ++c) sqrtW[c] = std::sqrt(s.weights[std::size_t(c)]);
 
-  auto load = [&](int first, int count, Eigen::MatrixXd& X) {
+  Eigen::VectorXd norms(n);
+  auto load = [&](int first, int count, Matrix& X) {
     X.resize(cells, count);
     loadFrames(s, first, count, [&](int f, const std::vector<float>& v) {
-      double* col = X.col(f).data();
-      for (Eigen::Index c = 0; c < cells; ++c) col[c] = sqrtW[c] * (double(v[std::size_t(c)]) - reference[std::size_t(c)]);
+      Scalar* col = X.col(f).data();
+      double squared = 0.0;
+      for (Eigen::Index c = 0; c < cells; ++c) {
+        const double x = sqrtW[c] * (double(v[std::size_t(c)]) - reference[std::size_t(c)]);
+        col[c] = Scalar(x);
+        squared += double(col[c]) * double(col[c]);  // n_i in double from the stored values
+      }
+      norms[first + f] = squared;
     });
   };
 
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);  // upper triangle filled
-  Eigen::VectorXd norms(n);
   const auto blocks = tiles(0, n, framesPerBlock);
-  Eigen::MatrixXd XP, XQ;
+  Matrix XP, XQ;
   for (std::size_t p = 0; p < blocks.size(); ++p) {
     load(blocks[p].first, blocks[p].count, XP);
-    norms.segment(blocks[p].first, blocks[p].count) = XP.colwise().squaredNorm().transpose();
     for (std::size_t q = p; q < blocks.size(); ++q) {
       if (q != p) load(blocks[q].first, blocks[q].count, XQ);
-      const Eigen::MatrixXd& Y = q == p ? XP : XQ;
+      const Matrix& Y = q == p ? XP : XQ;
       const auto tp = tiles(0, blocks[p].count, tileFrames);
       const auto tq = tiles(0, blocks[q].count, tileFrames);
       std::vector<std::pair<int, int>> pairs;
       for (int a = 0; a < int(tp.size()); ++a)
         for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
-      // Each tile product is one single-threaded GEMM (Eigen does not nest inside omp parallel);
-      // only tiles on or above the diagonal are computed.
+      // Each tile product is single-threaded GEMM (Eigen does not nest inside omp parallel); tiles
+      // are independent, which keeps both cores busy even when other processes share them. Only tiles
+      // on or above the diagonal are computed.
 #pragma omp parallel for schedule(dynamic, 1)
       for (int k = 0; k < int(pairs.size()); ++k) {
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
-        G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count).noalias() =
-            XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
+        auto target = G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count);
+        if constexpr (std::is_same_v<Scalar, double>) {
+          target.noalias() = XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
+        } else {
+          Eigen::MatrixXf partial(a.count, b.count);
+          for (Eigen::Index c0 = 0; c0 < cells; c0 += floatChunk) {
+            const Eigen::Index len = std::min(floatChunk, cells - c0);
+            partial.noalias() = XP.block(c0, a.first, len, a.count).transpose() * Y.block(c0, b.first, len, b.count);
+            target += partial.cast<double>();
+          }
+        }
       }
     }
   }
@@ -239,20 +261,26 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
 
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames, int* blocks,
-                               std::int64_t* clamped) {
+                               std::int64_t* clamped, GramPrecision precision) {
   const int n = series.frames;
   if (n < 1 || series.weights.empty()) {
     throw InputError("recurrence", "/frames", "no frames or no open cells to compare");
   }
   tileFrames = std::max(1, tileFrames);
   const std::int64_t bytesPerFrame =
-      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 ? 8 : 4);
-  // Two blocks are resident at a time (rows P and columns Q of the block pair).
-  std::int64_t perBlock = std::max<std::int64_t>(1, memoryBudgetBytes / (2 * bytesPerFrame));
-  int framesPerBlock = int(std::min<std::int64_t>(n, std::max<std::int64_t>(perBlock, 1)));
+      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 && precision == GramPrecision::Double ? 8 : 4);
+  // All frames in one block if they fit the budget; otherwise two blocks are resident at a time (rows
+  // P and columns Q of a block pair), each half the budget.
+  const std::int64_t perBlock = bytesPerFrame * n <= memoryBudgetBytes
+                                    ? n
+                                    : std::max<std::int64_t>(1, memoryBudgetBytes / (2 * bytesPerFrame));
+  const int framesPerBlock = int(std::min<std::int64_t>(n, perBlock));
   if (blocks) *blocks = (n + framesPerBlock - 1) / framesPerBlock;
   if (clamped) *clamped = 0;
-  if (norm == RecurrenceNorm::L2) return l2Distances(series, framesPerBlock, tileFrames, clamped);
+  if (norm == RecurrenceNorm::L2) {
+    return precision == GramPrecision::Double ? l2Distances<double>(series, framesPerBlock, tileFrames, clamped)
+                                              : l2Distances<float>(series, framesPerBlock, tileFrames, clamped);
+  }
   return directDistances(series, norm, framesPerBlock, tileFrames);
 }
 
@@ -274,7 +302,8 @@ RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const Recur
   int blocks = 1;
   std::int64_t clamped = 0;
   const Eigen::MatrixXd D =
-      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped);
+      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped,
+                     options.gram);
   RecurrenceMatrix m = normaliseDistances(D);
   m.norm = options.norm;
   m.field = options.field;

@@ -46,7 +46,7 @@ SamplingReport samplingCriterion(const FieldDatabase& db, const std::string& fie
   auto previous = db.frame(0), current = db.frame(1);
   for (int k = 1; k + 1 < n; ++k) {
     const auto next = db.frame(k + 1);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (m > 8192)
     for (std::int64_t i = 0; i < m; ++i) {
       const double g = field.value(*current, cells[std::size_t(i)]);
       // Central difference of gamma in time.
