@@ -85,7 +85,8 @@ template <class Store>
 void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
   const std::size_t cells = s.weights.size();
   std::exception_ptr failure;
-#pragma omp parallel
+  // Small loads stay on one thread: an OpenMP region costs more than it saves when cores are shared.
+#pragma omp parallel if (std::int64_t(count) * std::int64_t(cells) > (1 << 18))
   {
     std::vector<float> buffer(cells);
 #pragma omp for schedule(dynamic, 1)
@@ -149,7 +150,7 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
       // Each tile product is single-threaded GEMM (Eigen does not nest inside omp parallel); tiles
       // are independent, which keeps both cores busy even when other processes share them. Only tiles
       // on or above the diagonal are computed.
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
       for (int k = 0; k < int(pairs.size()); ++k) {
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
@@ -169,7 +170,7 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
   }
   std::int64_t negatives = 0;
   Eigen::MatrixXd& D = G;  // converted in place, upper triangle first
-#pragma omp parallel for schedule(dynamic, 16) reduction(+ : negatives)
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : negatives) if (n > 512)
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       double d = norms[i] + norms[j] - 2.0 * D(i, j);
@@ -217,7 +218,7 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
       std::vector<std::pair<int, int>> pairs;
       for (int a = 0; a < int(tp.size()); ++a)
         for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
       for (int k = 0; k < int(pairs.size()); ++k) {
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
