@@ -101,6 +101,28 @@ TEST(FieldDatabase, InterruptedWriterLeavesTheFramesWritten) {
   }
 }
 
+// A writer interrupted inside a frame may have extended some datasets: readers trust the frame count
+// written after each frame, and without one the shortest dataset.
+TEST(FieldDatabase, PartiallyWrittenFrameIsIgnored) {
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  const std::string path = writeWavyDatabase("partial.h5", g, 4);
+  {
+    hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    for (const char* name : {"/frames/alpha_p", "/frames/u_p"}) {
+      hdf5::Handle d(H5Dopen2(f, name, H5P_DEFAULT));
+      auto dims = hdf5::datasetDims(d);
+      dims[0] = 5;
+      ASSERT_GE(H5Dset_extent(d, dims.data()), 0);
+    }
+  }
+  EXPECT_EQ(FieldDatabase::open(path)->frameCount(), 4);  // frame_count = 4
+  {
+    hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    ASSERT_GE(H5Adelete_by_name(f, "/frames", "frame_count", H5P_DEFAULT), 0);
+  }
+  EXPECT_EQ(FieldDatabase::open(path)->frameCount(), 4);  // u_g has 4 frames
+}
+
 TEST(FieldDatabase, AbandonedWriterObjectInProcessIsReadable) {
   const CartesianGrid g = smallGrid(3, 3, 3);
   const std::string path = tempPath("abandoned.h5");
