@@ -29,7 +29,7 @@ SvgDocument recurrencePlot(const Eigen::MatrixXf& R, double dtRec, const std::st
   for (int j = 0; j < m; ++j)
     for (int i = 0; i < m; ++i) values[std::size_t(j) * m + i] = cells(i, j);  // x = t_i, y = t_j
   const double covered = double(m) * factor * dtRec;
-  svg.heatmapRuns(values, m, m, 0.0, covered, 0.0, covered);
+  svg.heatmapImage(values, m, m, 0.0, covered, 0.0, covered);
   svg.axes("t_i [s]", "t_j [s]");
   svg.textPx(310, 30, title, 14, "middle");
   // Colour bar right of the plot.

@@ -1,7 +1,7 @@
 #pragma once
 /// \file RecurrencePlot.hpp
 /// The recurrence plot (the paper's Fig. 6): R(t_i, t_j) as a heat map over the sampled time in seconds,
-/// block-averaged to at most ~400 x 400 cells so the SVG stays small.
+/// block-averaged to at most ~400 x 400 cells, embedded as one PNG image so the SVG stays small.
 
 #include <Eigen/Core>
 #include <string>

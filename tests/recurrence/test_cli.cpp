@@ -59,6 +59,7 @@ TEST(RecurrenceCommand, PrintsSummaryStoresMatrixAndDrawsThePlot) {
   const std::string picture = slurp(svg);
   EXPECT_NE(picture.find("<svg"), std::string::npos);
   EXPECT_NE(picture.find("t_i [s]"), std::string::npos);
+  EXPECT_NE(picture.find("data:image/png;base64,iVBORw0KGgo"), std::string::npos);  // PNG signature
 
   const Result l1 = solve(db + " --norm l1 --field u_p.y --all-cells --no-store --json");
   ASSERT_EQ(l1.code, 0) << l1.err;

@@ -4,6 +4,7 @@
 
 #include "../fields/FieldTestUtil.hpp"
 #include "recurrence/RecurrenceMatrix.hpp"
+#include "recurrence/RecurrencePlot.hpp"
 
 using namespace rcfd;
 using namespace rcfd::test;
@@ -190,4 +191,22 @@ TEST(RecurrenceMatrix, NaNInACachedFrameIsAnInputErrorNotACrash) {
   RecurrenceOptions o;
   o.field = "u_p.x";
   EXPECT_NE(expectInputError([&] { computeRecurrenceMatrix(*db, o); }, "/frames/u_p"), "NO EXCEPTION");
+}
+
+TEST(RecurrencePlot, DownsamplesByBlockMeans) {
+  Eigen::MatrixXf R(1000, 1000);
+  for (int j = 0; j < 1000; ++j)
+    for (int i = 0; i < 1000; ++i) R(i, j) = float((i + j) % 7) / 7.0f;
+  int factor = 0;
+  const Eigen::MatrixXd cells = downsampleRecurrence(R, 400, &factor);
+  EXPECT_EQ(factor, 3);
+  EXPECT_EQ(cells.rows(), 334);
+  double mean = 0.0;
+  for (int j = 3; j < 6; ++j)
+    for (int i = 6; i < 9; ++i) mean += R(i, j) / 9.0;
+  EXPECT_NEAR(cells(2, 1), mean, 1e-12);
+  EXPECT_NEAR(cells(333, 333), R(999, 999), 1e-12);  // the last, partial block holds one frame
+  const std::string svg = recurrencePlot(R, 0.005, "test").str();
+  EXPECT_NE(svg.find("<image"), std::string::npos);
+  EXPECT_LT(svg.size(), 1u << 20);
 }
