@@ -2,6 +2,7 @@
 // Eq. (6)-(7) with its summary, the sampling criterion of Eq. (8), the matrix stored into the database
 // (/recurrence/matrix) and the recurrence plot (the paper's Fig. 6).
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -69,14 +70,18 @@ int run(const Options& o) {
   std::vector<SamplingProbe> probes;
   for (std::size_t i = 0; i < o.probes.size(); ++i) probes.push_back(parseProbe(o.probes[i], i));
 
+  const auto openStart = std::chrono::steady_clock::now();
   auto db = FieldDatabase::open(o.database, FrameStorage{o.cacheBytes});
+  const double openSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - openStart).count();
   const auto& g = db->grid();
   std::int64_t open = 0;
   for (float f : db->fluidFraction()) open += f > 0.0f ? 1 : 0;
   std::cout << "database: " << o.database << "\n  frames N = " << db->frameCount()
             << ", dt_rec = " << fmt(db->dtRec()) << " s (" << fmt(db->frameCount() * db->dtRec())
             << " s sampled), grid " << g.shape[0] << " x " << g.shape[1] << " x " << g.shape[2] << ", "
-            << open << " open cells\n";
+            << open << " open cells\n  opened in " << fmt(openSeconds, "%.3f") << " s ("
+            << (o.cacheBytes == 0 ? "all frames in RAM" : "frame cache of " + std::to_string(o.cacheBytes) + " bytes")
+            << ")\n";
 
   const RecurrenceMatrix m = computeRecurrenceMatrix(*db, ro);
   const RecurrenceSummary summary = summariseRecurrence(m.R);

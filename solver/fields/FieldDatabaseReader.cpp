@@ -209,8 +209,12 @@ Header readHeader(hid_t file, const std::string& path) {
   std::vector<double> values[3];
   for (int a = 0; a < 3; ++a) {
     auto x = hdf5::readNumericAttribute(grid, names[a]);
-    if (!x || x->size() != 3) {
-      v.push_back({std::string("/grid@") + names[a], "numeric attribute with 3 values is missing"});
+    if (!x) {
+      v.push_back({std::string("/grid@") + names[a], "numeric attribute with 3 values (x, y, z) is missing"});
+    } else if (x->size() != 3) {
+      v.push_back({std::string("/grid@") + names[a],
+                   "has " + std::to_string(x->size()) +
+                       " values; the grid is uniform and needs exactly 3, one per axis (x, y, z)"});
     } else {
       values[a] = *x;
     }
