@@ -210,3 +210,17 @@ TEST(RecurrencePlot, DownsamplesByBlockMeans) {
   EXPECT_NE(svg.find("<image"), std::string::npos);
   EXPECT_LT(svg.size(), 1u << 20);
 }
+
+// The same matrix whether the frames come from RAM or through a small LRU cache.
+TEST(RecurrenceMatrix, FrameCacheGivesTheSameMatrixAsRam) {
+  const CartesianGrid g = smallGrid(6, 5, 4);
+  const std::string path = writeWavyDatabase("cache-matrix.h5", g, 25);
+  auto ram = FieldDatabase::open(path);
+  auto cached = FieldDatabase::open(path, FrameStorage{4 * ram->frameBytes()});
+  RecurrenceOptions o;
+  o.memoryBudgetBytes = 4000;  // several blocks: frames are fetched more than once
+  o.tileFrames = 3;
+  const RecurrenceMatrix a = computeRecurrenceMatrix(*ram, o), b = computeRecurrenceMatrix(*cached, o);
+  EXPECT_EQ(a.R, b.R);
+  EXPECT_GT(cached->cacheStats().misses, 25);  // blocks re-read frames evicted from the 4-frame cache
+}
