@@ -121,7 +121,11 @@ int run(const Options& o) {
   const int frames = db->frameCount();
   db.reset();  // the file must be closed before it is reopened for writing
   if (!o.noStore) {
-    storeRecurrenceMatrix(o.database, m);
+    try {
+      storeRecurrenceMatrix(o.database, m);
+    } catch (const RunError& e) {
+      throw RunError(std::string(e.what()) + " (the report above is complete; --no-store skips storing)");
+    }
     std::cout << "matrix stored in " << o.database << ":/recurrence/matrix\n";
   }
   if (!o.svg.empty()) {
