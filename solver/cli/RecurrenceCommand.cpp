@@ -30,7 +30,7 @@ struct Options {
   bool allCells = false;
   bool noStore = false;
   bool json = false;
-  bool floatGram = false;
+  std::string gram = "auto";
   std::int64_t cacheBytes = 0;
   double memoryBudgetMb = 1536.0;
 };
@@ -62,7 +62,10 @@ int run(const Options& o) {
   RecurrenceOptions ro;
   ro.norm = parseRecurrenceNorm(o.norm);
   ro.field = o.field;
-  if (o.floatGram) ro.gram = GramPrecision::FloatChunked;
+  if (o.gram == "double") ro.gram = GramPrecision::Double;
+  else if (o.gram == "float") ro.gram = GramPrecision::FloatChunked;
+  else if (o.gram != "auto")
+    throw InputError("rcfd-solve recurrence", "--gram", "\"" + o.gram + "\" is not one of: auto double float");
   parseFieldComponent(o.field);               // refuse a bad name before loading anything
   parseFieldComponent(o.samplingField, "--sampling-field");
   if (!(o.memoryBudgetMb > 0.0)) throw InputError("rcfd-solve recurrence", "--memory-budget", "must be > 0 [MB]");
@@ -89,6 +92,13 @@ int run(const Options& o) {
             << "  computed in " << fmt(m.seconds, "%.3f") << " s (" << m.frameBlocks << " frame block"
             << (m.frameBlocks == 1 ? "" : "s") << "), normalisation max D = " << fmt(m.normalisation) << "\n"
             << "  mean off-diagonal R = " << fmt(summary.meanOffDiagonal) << "\n";
+  if (m.norm == RecurrenceNorm::L2) {
+    std::cout << "  Gram arithmetic: " << (m.gramUsed == GramPrecision::Double ? "double" : "float chunks summed in double");
+    if (ro.gram == GramPrecision::Auto)
+      std::cout << " (spot check max |R - R_exact| = " << fmt(m.spotCheckError, "%.2g")
+                << (m.autoFellBack ? ", above the tolerance: recomputed in double" : "") << ")";
+    std::cout << "\n";
+  }
   if (m.clampedNegatives > 0)
     std::cout << "  " << m.clampedNegatives << " round-off negative distances set to 0\n";
   std::cout << "  strongest recurrence lags:";
@@ -142,6 +152,7 @@ int run(const Options& o) {
     j["norm"] = toString(m.norm);
     j["field"] = m.field;
     j["matrix_seconds"] = m.seconds;
+    j["gram"] = m.gramUsed == GramPrecision::Double ? "double" : "float_chunked";
     j["mean_off_diagonal"] = summary.meanOffDiagonal;
     j["lags"] = nlohmann::json::array();
     for (const auto& lag : summary.strongestLags) j["lags"].push_back({{"lag", lag.lag}, {"mean_r", lag.meanR}});
@@ -166,9 +177,9 @@ const bool registered = addCommand(
       app.add_flag("--all-cells", o->allCells, "sampling criterion over every open cell");
       app.add_option("--cache-bytes", o->cacheBytes, "frame cache size in bytes (default 0: all frames in RAM)");
       app.add_option("--memory-budget", o->memoryBudgetMb, "MB of frames converted to double at a time (default 1536)");
-      app.add_flag("--float-gram", o->floatGram,
-                   "L2 Gram matrix by float GEMMs over 2048-cell chunks summed in double (about 2x faster, "
-                   "R within ~1e-6 of double)");
+      app.add_option("--gram", o->gram,
+                     "L2 arithmetic: auto (default: float GEMM over 512-cell chunks summed in double, spot-checked, "
+                     "double if the check fails), double, float");
       app.add_flag("--no-store", o->noStore, "do not write /recurrence/matrix into the database");
       app.add_flag("--json", o->json, "print a JSON summary as the last line");
       return [o] { return run(*o); };

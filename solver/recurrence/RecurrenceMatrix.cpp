@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <random>
 #include <type_traits>
 
 #include "core/Errors.hpp"
@@ -111,7 +112,7 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
 template <class Scalar>
 Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileFrames, std::int64_t* clamped) {
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
-  constexpr Eigen::Index floatChunk = 2048;
+  constexpr Eigen::Index floatChunk = 512;
   const int n = s.frames;
   const Eigen::Index cells = Eigen::Index(s.weights.size());
   std::vector<float> reference(s.weights.size());
@@ -269,7 +270,7 @@ Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
   }
   tileFrames = std::max(1, tileFrames);
   const std::int64_t bytesPerFrame =
-      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 && precision == GramPrecision::Double ? 8 : 4);
+      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 && precision != GramPrecision::FloatChunked ? 8 : 4);
   // All frames in one block if they fit the budget; otherwise two blocks are resident at a time (rows
   // P and columns Q of a block pair), each half the budget.
   const std::int64_t perBlock = bytesPerFrame * n <= memoryBudgetBytes
@@ -279,8 +280,8 @@ Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
   if (blocks) *blocks = (n + framesPerBlock - 1) / framesPerBlock;
   if (clamped) *clamped = 0;
   if (norm == RecurrenceNorm::L2) {
-    return precision == GramPrecision::Double ? l2Distances<double>(series, framesPerBlock, tileFrames, clamped)
-                                              : l2Distances<float>(series, framesPerBlock, tileFrames, clamped);
+    return precision == GramPrecision::FloatChunked ? l2Distances<float>(series, framesPerBlock, tileFrames, clamped)
+                                                    : l2Distances<double>(series, framesPerBlock, tileFrames, clamped);
   }
   return directDistances(series, norm, framesPerBlock, tileFrames);
 }
@@ -298,18 +299,67 @@ RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D) {
   return m;
 }
 
-RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const RecurrenceOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+namespace {
+
+// Largest |R(i, j) - R_exact(i, j)| over `pairs` seeded random entries and the most distant pair, with
+// R_exact from Eq. (6) summed in double straight from the frames (normalised by m's max D).
+double spotCheck(const ScalarSeries& s, const RecurrenceMatrix& m, int pairs) {
+  const int n = s.frames;
+  std::vector<std::pair<int, int>> entries;
+  Eigen::Index fi = 0, fj = 0;
+  m.R.minCoeff(&fi, &fj);
+  entries.emplace_back(int(fi), int(fj));
+  std::mt19937_64 rng(20240521);
+  for (int k = 0; k < pairs; ++k)
+    entries.emplace_back(int(rng() % std::uint64_t(n)), int(rng() % std::uint64_t(n)));
+  const std::size_t cells = s.weights.size();
+  double worst = 0.0;
+  std::vector<float> a(cells), b(cells);
+  for (const auto& [i, j] : entries) {
+    s.fetch(i, a.data());
+    s.fetch(j, b.data());
+    double d = 0.0;
+    for (std::size_t c = 0; c < cells; ++c) {
+      const double diff = double(a[c]) - double(b[c]);
+      d += s.weights[c] * diff * diff;  // Eq. (6)
+    }
+    const double exact = m.normalisation > 0.0 ? 1.0 - d / m.normalisation : 1.0;
+    worst = std::max(worst, std::abs(exact - double(m.R(i, j))));
+  }
+  return worst;
+}
+
+RecurrenceMatrix computeOnce(const ScalarSeries& series, const RecurrenceOptions& options, GramPrecision gram) {
   int blocks = 1;
   std::int64_t clamped = 0;
   const Eigen::MatrixXd D =
-      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped,
-                     options.gram);
+      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped, gram);
   RecurrenceMatrix m = normaliseDistances(D);
   m.norm = options.norm;
   m.field = options.field;
   m.frameBlocks = blocks;
   m.clampedNegatives = clamped;
+  m.gramUsed = gram;
+  return m;
+}
+
+}  // namespace
+
+RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const RecurrenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  RecurrenceMatrix m;
+  if (options.norm != RecurrenceNorm::L2 || options.gram != GramPrecision::Auto) {
+    m = computeOnce(series, options, options.gram == GramPrecision::Auto ? GramPrecision::Double : options.gram);
+  } else {
+    m = computeOnce(series, options, GramPrecision::FloatChunked);
+    m.spotCheckError = spotCheck(series, m, options.autoCheckPairs);
+    if (!(m.spotCheckError <= options.autoTolerance)) {
+      const double failedError = m.spotCheckError;
+      m = computeOnce(series, options, GramPrecision::Double);
+      m.spotCheckError = failedError;
+      m.autoFellBack = true;
+    }
+  }
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return m;
 }

@@ -57,10 +57,12 @@ struct ScalarSeries {
 /// The open cells (fluid fraction > 0) of a database and the chosen field on them.
 ScalarSeries scalarSeries(const FieldDatabase& db, const FieldComponent& field);
 
-/// Arithmetic of the L2 Gram matrix: double GEMM, or float GEMM over chunks of 2048 cells with the
-/// chunks summed in double (about twice as fast, errors about 1e-7 instead of 1e-15; see
-/// docs/performance.md).
-enum class GramPrecision { Double, FloatChunked };
+/// Arithmetic of the L2 Gram matrix. Double: double GEMM (R within ~3e-8 of a naive double loop).
+/// FloatChunked: float GEMMs over chunks of 512 cells, the chunks summed in double (about twice as
+/// fast; R within ~3e-7 at the paper's size). Auto (default): FloatChunked, then a spot check of
+/// autoCheckPairs entries (and the most distant pair) against exact double sums; if any differs by
+/// more than autoTolerance the matrix is recomputed in Double. docs/recurrence.md has the figures.
+enum class GramPrecision { Double, FloatChunked, Auto };
 
 struct RecurrenceOptions {
   RecurrenceNorm norm = RecurrenceNorm::L2;
@@ -68,7 +70,9 @@ struct RecurrenceOptions {
   /// Frames converted to double at a time are limited to this many bytes (two blocks resident).
   std::int64_t memoryBudgetBytes = std::int64_t(1536) << 20;
   int tileFrames = 128;  ///< frames per tile of the parallel loop over tile pairs
-  GramPrecision gram = GramPrecision::Double;
+  GramPrecision gram = GramPrecision::Auto;
+  int autoCheckPairs = 64;       ///< Auto: random entries checked against exact double sums
+  double autoTolerance = 3e-7;   ///< Auto: largest accepted |R - R_exact| in the check (target 1e-6)
 };
 
 struct RecurrenceMatrix {
@@ -79,6 +83,9 @@ struct RecurrenceMatrix {
   int frameBlocks = 1;           ///< memory blocks the frames were split into
   std::int64_t clampedNegatives = 0;  ///< round-off D < 0 set to 0 (L2 only)
   double seconds = 0.0;          ///< wall time of the computation
+  GramPrecision gramUsed = GramPrecision::Double;  ///< L2: the arithmetic that produced R
+  double spotCheckError = 0.0;   ///< Auto: largest |R - R_exact| over the checked entries
+  bool autoFellBack = false;     ///< Auto: the float result failed the check; R is the double one
 };
 
 /// D(i, j) (before normalisation) for the series; `blocks` and `clamped` report the blocking and the

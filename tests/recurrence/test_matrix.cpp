@@ -49,9 +49,32 @@ std::shared_ptr<FieldDatabase> wavyDb(int frames = 40, int nx = 6, int ny = 5, i
 TEST(RecurrenceMatrix, GramEqualsNaiveDoubleLoop) {
   auto db = wavyDb();
   const Eigen::MatrixXd expected = naiveR(naiveDistances(*db, "alpha_p", RecurrenceNorm::L2));
-  const RecurrenceMatrix m = computeRecurrenceMatrix(*db);
-  EXPECT_EQ(m.frameBlocks, 1);
-  EXPECT_LT((m.R.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6);
+  for (GramPrecision gram : {GramPrecision::Double, GramPrecision::Auto}) {
+    RecurrenceOptions o;
+    o.gram = gram;
+    const RecurrenceMatrix m = computeRecurrenceMatrix(*db, o);
+    EXPECT_EQ(m.frameBlocks, 1);
+    EXPECT_LT((m.R.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6);
+    if (gram == GramPrecision::Auto) {
+      // Either the float result passed its spot check or it was replaced by the double one.
+      EXPECT_EQ(m.gramUsed, m.autoFellBack ? GramPrecision::Double : GramPrecision::FloatChunked);
+      EXPECT_EQ(m.autoFellBack, m.spotCheckError > o.autoTolerance);
+    }
+  }
+}
+
+// Auto falls back to double when the spot check fails (forced here with a zero tolerance).
+TEST(RecurrenceMatrix, AutoFallsBackToDoubleWhenTheSpotCheckFails) {
+  auto db = wavyDb(30);
+  RecurrenceOptions o;
+  o.autoTolerance = 0.0;
+  const RecurrenceMatrix automatic = computeRecurrenceMatrix(*db, o);
+  o.gram = GramPrecision::Double;
+  const RecurrenceMatrix exact = computeRecurrenceMatrix(*db, o);
+  EXPECT_TRUE(automatic.autoFellBack);
+  EXPECT_EQ(automatic.gramUsed, GramPrecision::Double);
+  EXPECT_GT(automatic.spotCheckError, 0.0);
+  EXPECT_EQ(automatic.R, exact.R);
 }
 
 TEST(RecurrenceMatrix, BlockedOverFramesEqualsUnblocked) {
@@ -59,12 +82,15 @@ TEST(RecurrenceMatrix, BlockedOverFramesEqualsUnblocked) {
   const Eigen::MatrixXd expected = naiveR(naiveDistances(*db, "alpha_p", RecurrenceNorm::L2));
   std::int64_t openCells = 0;
   for (float f : db->fluidFraction()) openCells += f > 0.0f;
-  RecurrenceOptions o;
-  o.memoryBudgetBytes = 2 * openCells * 8 * 7;  // 7 frames per block
-  o.tileFrames = 3;
-  const RecurrenceMatrix m = computeRecurrenceMatrix(*db, o);
-  EXPECT_EQ(m.frameBlocks, 6);
-  EXPECT_LT((m.R.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6);
+  for (GramPrecision gram : {GramPrecision::Double, GramPrecision::FloatChunked}) {
+    RecurrenceOptions o;
+    o.gram = gram;
+    o.memoryBudgetBytes = 2 * openCells * 8 * 7;  // 7 double (14 float) frames per block
+    o.tileFrames = 3;
+    const RecurrenceMatrix m = computeRecurrenceMatrix(*db, o);
+    EXPECT_EQ(m.frameBlocks, gram == GramPrecision::Double ? 6 : 3);
+    EXPECT_LT((m.R.cast<double>() - expected).cwiseAbs().maxCoeff(), 1e-6);
+  }
 }
 
 TEST(RecurrenceMatrix, FloatChunkedGramMeetsTheTolerance) {
