@@ -4,7 +4,8 @@
 ///   R(i, j) = 1 - D(i, j) / max D,  D(i, j) = sum_c V_c (a_i,c - a_j,c)^2
 /// with V_c the open volume of cell c (fluid fraction x cell volume) and a the compared field
 /// (alpha_P by default: the paper's alpha_G = 1 - alpha_P gives the same differences). The L2 norm is
-/// computed through the Gram matrix, D = n_i + n_j - 2 G_ij with G = X^T W X, in double precision,
+/// computed through the Gram matrix, D = n_i + n_j - 2 G_ij with G = X^T W X, accumulated in double
+/// (GramPrecision),
 /// blocked over frames so only a memory budget's worth of frames is converted at a time. The L1 norm
 /// (sum_c V_c |a_i - a_j|) and the max norm (max_c |a_i - a_j| over open cells) follow
 /// CFDEMcoupling-PFM's absDiffNorm and maxNorm; they have no Gram form and use a blocked direct loop.
