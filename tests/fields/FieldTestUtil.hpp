@@ -19,12 +19,23 @@
 
 namespace rcfd::test {
 
-/// A path in a per-process temporary directory, removed by the caller (or left in /tmp).
+/// A per-process temporary directory, removed when the test program exits normally (forked children
+/// leave with _exit and do not remove it).
+struct TempDirectory {
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("rcfd-test-" + std::to_string(::getpid()));
+  TempDirectory() { std::filesystem::create_directories(path); }
+  ~TempDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+
+/// A fresh path in the test program's temporary directory.
 inline std::string tempPath(const std::string& name) {
+  static TempDirectory dir;
   static std::atomic<int> counter{0};
-  const auto dir = std::filesystem::temp_directory_path() / ("rcfd-test-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / (std::to_string(counter++) + "-" + name)).string();
+  return (dir.path / (std::to_string(counter++) + "-" + name)).string();
 }
 
 inline CartesianGrid smallGrid(int nx = 4, int ny = 3, int nz = 2, double h = 0.01) {
