@@ -29,6 +29,8 @@ double closure(const nlohmann::json& m) {
 
 TEST(Spray, MassBalanceClosesOverAHundredThousandSteps) {
   Scene s = sprayBoxScene(400, 0.3, 0.08);
+  // The particles rest (u_P = 0): the tracers need no transport, only the spray books are under test.
+  s.effects = {"tracer_volume_fraction", "spray", "deposition", "coverage", "deposition_maps"};
   auto db = sprayBoxDatabase(s, 0.3, 0.08, 3.0);
   const std::int64_t steps = 100000;
   TracerSimulation sim(s, db, sequentialPath(db->frameCount(), steps + 2), {3, steps, 0});
