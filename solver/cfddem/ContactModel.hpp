@@ -1,0 +1,77 @@
+#pragma once
+/// \file ContactModel.hpp
+/// Contact models of the DEM, selected by name through rcfd::Registry (LAMMPS pair styles): a contact
+/// model computes all particle-particle contacts of the neighbour list and all particle-wall contacts
+/// in one call each, so the per-contact work is inlined, not a virtual call. Rolling friction is a
+/// separate model (scene effect `rolling_friction`) that a contact model applies when given one.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cfddem/DemMaterial.hpp"
+#include "cfddem/DemParticles.hpp"
+#include "cfddem/DemWalls.hpp"
+#include "cfddem/NeighbourList.hpp"
+#include "core/Registry.hpp"
+
+namespace rcfd {
+
+/// Tangential history of particle-wall contacts: up to `slots` per particle, keyed by wall primitive.
+struct WallHistory {
+  static constexpr int slots = 8;
+  std::vector<int> wall;                 ///< primitive index, -1 for a free slot (size N * slots)
+  std::vector<Eigen::Vector3d> shear;    ///< tangential displacement [m] (size N * slots)
+  void resize(std::size_t n) {
+    wall.resize(n * slots, -1);
+    shear.resize(n * slots, Eigen::Vector3d::Zero());
+  }
+};
+
+/// Per-pair results of the particle-particle pass (indexed like the neighbour list's pairs).
+struct PairForces {
+  std::vector<Eigen::Vector3d> force;     ///< force on i (on j: the opposite) [N]
+  std::vector<Eigen::Vector3d> torque_i;  ///< [N m]
+  std::vector<Eigen::Vector3d> torque_j;  ///< [N m]
+  void resize(std::size_t n) { force.resize(n); torque_i.resize(n); torque_j.resize(n); }
+};
+
+/// Everything a contact model reads and writes in one force evaluation.
+struct ContactContext {
+  DemParticles& particles;
+  NeighbourList& list;
+  const DemWalls& walls;
+  WallHistory& wall_history;
+  PairForces& pair_forces;
+  double dt;                        ///< DEM time step [s] (tangential history increments)
+  double max_overlap_fraction = 0;  ///< out: largest delta / r of any contact this evaluation
+  long contacts = 0;                ///< out: number of touching particle-particle pairs
+  long wall_contacts = 0;           ///< out: number of particle-wall contacts
+};
+
+/// A rolling-resistance model (the effect `rolling_friction`). Its torque law is applied inside the
+/// contact model's loop; the object names the law and carries nothing else.
+class RollingModel {
+ public:
+  virtual ~RollingModel() = default;
+  virtual std::string name() const = 0;
+};
+
+class ContactModel {
+ public:
+  virtual ~ContactModel() = default;
+  virtual std::string name() const = 0;
+  /// Uses `rolling` (may be null: no rolling resistance). Refuses a law it does not implement.
+  virtual void setRollingModel(const RollingModel* rolling) = 0;
+  /// Particle-particle contacts: writes ctx.pair_forces for every listed pair (zero when apart) and
+  /// updates the pairs' tangential history. Does not touch the particles' accumulators.
+  virtual void computePairs(ContactContext& ctx) const = 0;
+  /// Particle-wall contacts: adds forces and torques to the particles' accumulators.
+  virtual void computeWalls(ContactContext& ctx) const = 0;
+};
+
+using ContactModelRegistry = Registry<ContactModel, const DemMaterial&>;
+using RollingModelRegistry = Registry<RollingModel, const DemMaterial&>;
+
+}  // namespace rcfd

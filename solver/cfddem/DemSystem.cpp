@@ -1,0 +1,144 @@
+#include "cfddem/DemSystem.hpp"
+#include "cfddem/DemParallel.hpp"
+
+#include <cmath>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+
+#include "core/Errors.hpp"
+
+namespace rcfd {
+
+using Eigen::Vector3d;
+
+DemSettings DemSystem::settingsFromScene(const Scene& scene) {
+  DemSettings s;
+  s.time_step = scene.dem.time_step;
+  s.max_rayleigh_fraction = scene.dem.max_rayleigh_fraction;
+  s.max_overlap_fraction = scene.dem.max_overlap_fraction;
+  s.rolling_model = scene.hasEffect("rolling_friction") ? "cdt" : "";
+  return s;
+}
+
+DemSystem::DemSystem(const DemMaterial& material, DemWalls walls, const DemSettings& settings)
+    : material_(material), walls_(std::move(walls)), settings_(settings),
+      list_(settings.skin_fraction * material.particle_radius) {
+  rayleigh_fraction_ = checkTimeStep(material_, settings_.time_step, settings_.max_rayleigh_fraction);
+  spdlog::info("DEM: dt = {:.4g} s is {:.3f} of the Rayleigh time {:.4g} s (parcel radius {:.4g} m)",
+               settings_.time_step, rayleigh_fraction_, material_.rayleighTime(),
+               material_.particle_radius);
+  try {
+    model_ = ContactModelRegistry::create(settings_.contact_model, material_);
+    if (!settings_.rolling_model.empty())
+      rolling_ = RollingModelRegistry::create(settings_.rolling_model, material_);
+  } catch (const std::out_of_range& e) {
+    throw InputError("scene", settings_.rolling_model.empty() ? "/dem/contact_model" : "/effects",
+                     e.what());
+  }
+  model_->setRollingModel(rolling_.get());
+}
+
+std::size_t DemSystem::addParticle(const Vector3d& x, const Vector3d& v) {
+  forces_valid_ = false;
+  return particles_.add(x, v, material_.particle_radius, material_.density);
+}
+
+void DemSystem::resizeState() {
+  wall_history_.resize(particles_.size());
+}
+
+void DemSystem::computeForces() {
+  if (wall_history_.wall.size() != particles_.size() * WallHistory::slots) resizeState();
+  if (list_.needsRebuild(particles_)) {
+    list_.build(particles_, walls_);
+    pair_forces_.resize(list_.pairs());
+  }
+  ContactContext ctx{particles_, list_, walls_, wall_history_, pair_forces_, settings_.time_step};
+  model_->computePairs(ctx);
+  const long n = static_cast<long>(particles_.size());
+  const Vector3d g = settings_.gravity;
+  DemParticles& p = particles_;
+  // Gather in a fixed order (own pairs, then pairs as second member): independent of threads.
+#pragma omp parallel for schedule(static) if (n >= kDemParallelMinParticles)
+  for (long i = 0; i < n; ++i) {
+    Vector3d f = p.mass[i] * g;
+    Vector3d t = Vector3d::Zero();
+    for (auto q = list_.row_start[i]; q < list_.row_start[i + 1]; ++q) {
+      f += pair_forces_.force[q];
+      t += pair_forces_.torque_i[q];
+    }
+    for (auto c = list_.col_start[i]; c < list_.col_start[i + 1]; ++c) {
+      const auto q = list_.col_pair[c];
+      f -= pair_forces_.force[q];
+      t += pair_forces_.torque_j[q];
+    }
+    p.force[i] = f;
+    p.torque[i] = t;
+  }
+  model_->computeWalls(ctx);
+  stats_ = DemStepStats{ctx.max_overlap_fraction, ctx.contacts, ctx.wall_contacts};
+  if (ctx.max_overlap_fraction > max_overlap_seen_) max_overlap_seen_ = ctx.max_overlap_fraction;
+  if (!overlap_warned_ && ctx.max_overlap_fraction > settings_.max_overlap_fraction) {
+    overlap_warned_ = true;
+    spdlog::warn("DEM: an overlap reached {:.3g} of the radius at t = {:.4g} s, above "
+                 "/dem/max_overlap_fraction {:.3g} (Lommen et al.): stiffer particles or slower "
+                 "impacts keep the Hertz model accurate (warned once per run)",
+                 ctx.max_overlap_fraction, time_, settings_.max_overlap_fraction);
+  }
+  forces_valid_ = true;
+}
+
+void DemSystem::step() {
+  if (!forces_valid_) computeForces();
+  const double dt = settings_.time_step, h = 0.5 * dt;
+  const long n = static_cast<long>(particles_.size());
+  DemParticles& p = particles_;
+#pragma omp parallel for schedule(static) if (n >= kDemParallelMinParticles)
+  for (long i = 0; i < n; ++i) {
+    p.v[i] += (h * p.inv_mass[i]) * p.force[i];
+    p.omega[i] += (h * p.inv_inertia[i]) * p.torque[i];
+    p.x[i] += dt * p.v[i];
+  }
+  computeForces();
+#pragma omp parallel for schedule(static) if (n >= kDemParallelMinParticles)
+  for (long i = 0; i < n; ++i) {
+    p.v[i] += (h * p.inv_mass[i]) * p.force[i];
+    p.omega[i] += (h * p.inv_inertia[i]) * p.torque[i];
+  }
+  time_ += dt;
+  ++steps_;
+}
+
+void DemSystem::run(long steps) {
+  for (long s = 0; s < steps; ++s) step();
+}
+
+double DemSystem::elasticEnergy() const {
+  const DemParticles& p = particles_;
+  double e = 0.0;
+  auto hertz = [](const ContactParams& c, double r_eff, double delta) {
+    return 8.0 / 15.0 * c.y_eff * std::sqrt(r_eff) * std::pow(delta, 2.5);
+  };
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (auto q = list_.row_start.empty() ? 0 : list_.row_start[i];
+         !list_.row_start.empty() && q < list_.row_start[i + 1]; ++q) {
+      const auto k = list_.j[q];
+      const double delta = p.radius[i] + p.radius[k] - (p.x[i] - p.x[k]).norm();
+      if (delta > 0.0)
+        e += hertz(material_.particle_particle, p.radius[i] * p.radius[k] / (p.radius[i] + p.radius[k]),
+                   delta);
+    }
+    for (std::size_t k = 0; k < walls_.size(); ++k) {
+      WallContact wc;
+      if (walls_.contact(k, p.x[i], p.radius[i], wc))
+        e += hertz(material_.particle_wall, p.radius[i], p.radius[i] - wc.distance);
+    }
+  }
+  return e;
+}
+
+double DemSystem::totalEnergy() const {
+  return particles_.kineticEnergy() + particles_.gravityPotential(settings_.gravity) + elasticEnergy();
+}
+
+}  // namespace rcfd
