@@ -67,8 +67,10 @@ class ContactModel {
   /// Particle-particle contacts: writes ctx.pair_forces for every listed pair (zero when apart) and
   /// updates the pairs' tangential history. Does not touch the particles' accumulators.
   virtual void computePairs(ContactContext& ctx) const = 0;
-  /// Particle-wall contacts: adds forces and torques to the particles' accumulators.
-  virtual void computeWalls(ContactContext& ctx) const = 0;
+  /// Particle-wall contacts of particle i: adds to `force` and `torque`, updates i's wall history;
+  /// raises `max_overlap` (delta / r) and counts contacts. Called concurrently for different i.
+  virtual void computeWalls(ContactContext& ctx, long i, Eigen::Vector3d& force,
+                            Eigen::Vector3d& torque, double& max_overlap, long& contacts) const = 0;
 };
 
 using ContactModelRegistry = Registry<ContactModel, const DemMaterial&>;

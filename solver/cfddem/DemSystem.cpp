@@ -47,9 +47,11 @@ void DemSystem::resizeState() {
   wall_history_.resize(particles_.size());
 }
 
-void DemSystem::computeForces() {
+void DemSystem::computeForces(bool final_kick, int moved) {
   if (wall_history_.wall.size() != particles_.size() * WallHistory::slots) resizeState();
-  if (list_.needsRebuild(particles_)) {
+  const bool rebuild = moved < 0 ? list_.needsRebuild(particles_)
+                                 : (moved > 0 || list_.positionsAtBuild().size() != particles_.size());
+  if (rebuild) {
     list_.build(particles_, walls_);
     pair_forces_.resize(list_.pairs());
   }
@@ -57,9 +59,13 @@ void DemSystem::computeForces() {
   model_->computePairs(ctx);
   const long n = static_cast<long>(particles_.size());
   const Vector3d g = settings_.gravity;
+  const double h = 0.5 * settings_.time_step;
   DemParticles& p = particles_;
-  // Gather in a fixed order (own pairs, then pairs as second member): independent of threads.
-#pragma omp parallel for schedule(static) if (n >= kDemParallelMinParticles)
+  double max_overlap = 0.0;
+  long wall_contacts = 0;
+  // Gather in a fixed order (own pairs, then pairs as second member, then walls): independent of
+  // the thread count. The second half kick of velocity Verlet is fused into the same loop.
+#pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : wall_contacts) if (n >= kDemParallelMinParticles)
   for (long i = 0; i < n; ++i) {
     Vector3d f = p.mass[i] * g;
     Vector3d t = Vector3d::Zero();
@@ -72,10 +78,17 @@ void DemSystem::computeForces() {
       f -= pair_forces_.force[q];
       t += pair_forces_.torque_j[q];
     }
+    if (list_.wall_start[i] != list_.wall_start[i + 1])
+      model_->computeWalls(ctx, i, f, t, max_overlap, wall_contacts);
     p.force[i] = f;
     p.torque[i] = t;
+    if (final_kick) {
+      p.v[i] += (h * p.inv_mass[i]) * f;
+      p.omega[i] += (h * p.inv_inertia[i]) * t;
+    }
   }
-  model_->computeWalls(ctx);
+  ctx.max_overlap_fraction = std::max(ctx.max_overlap_fraction, max_overlap);
+  ctx.wall_contacts += wall_contacts;
   stats_ = DemStepStats{ctx.max_overlap_fraction, ctx.contacts, ctx.wall_contacts};
   if (ctx.max_overlap_fraction > max_overlap_seen_) max_overlap_seen_ = ctx.max_overlap_fraction;
   if (!overlap_warned_ && ctx.max_overlap_fraction > settings_.max_overlap_fraction) {
@@ -89,22 +102,23 @@ void DemSystem::computeForces() {
 }
 
 void DemSystem::step() {
-  if (!forces_valid_) computeForces();
+  if (!forces_valid_) computeForces(false, -1);
   const double dt = settings_.time_step, h = 0.5 * dt;
   const long n = static_cast<long>(particles_.size());
   DemParticles& p = particles_;
-#pragma omp parallel for schedule(static) if (n >= kDemParallelMinParticles)
+  // The list's displacement test is fused into the drift: one pass, one barrier.
+  const auto& x_build = list_.positionsAtBuild();
+  const bool have_build = x_build.size() == p.size();
+  const double limit2 = list_.rebuildDistance2();
+  int moved = have_build ? 0 : 1;
+#pragma omp parallel for schedule(static) reduction(| : moved) if (n >= kDemParallelMinParticles)
   for (long i = 0; i < n; ++i) {
     p.v[i] += (h * p.inv_mass[i]) * p.force[i];
     p.omega[i] += (h * p.inv_inertia[i]) * p.torque[i];
     p.x[i] += dt * p.v[i];
+    if (have_build) moved |= (p.x[i] - x_build[i]).squaredNorm() > limit2 ? 1 : 0;
   }
-  computeForces();
-#pragma omp parallel for schedule(static) if (n >= kDemParallelMinParticles)
-  for (long i = 0; i < n; ++i) {
-    p.v[i] += (h * p.inv_mass[i]) * p.force[i];
-    p.omega[i] += (h * p.inv_inertia[i]) * p.torque[i];
-  }
+  computeForces(true, moved);
   time_ += dt;
   ++steps_;
 }

@@ -78,7 +78,9 @@ class DemSystem {
   double totalEnergy() const;
 
  private:
-  void computeForces();
+  /// Forces and torques of the current positions; with final_kick also the second half kick.
+  /// moved: 1/0 whether the caller found a displacement above half the skin, -1 to test here.
+  void computeForces(bool final_kick, int moved);
   void resizeState();
 
   DemMaterial material_;

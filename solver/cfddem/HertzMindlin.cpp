@@ -28,9 +28,10 @@ void HertzMindlin::computePairs(ContactContext& ctx) const {
   else pairs<false>(ctx);
 }
 
-void HertzMindlin::computeWalls(ContactContext& ctx) const {
-  if (rolling_) walls<true>(ctx);
-  else walls<false>(ctx);
+void HertzMindlin::computeWalls(ContactContext& ctx, long i, Vector3d& force, Vector3d& torque,
+                                double& max_overlap, long& contacts) const {
+  if (rolling_) walls<true>(ctx, i, force, torque, max_overlap, contacts);
+  else walls<false>(ctx, i, force, torque, max_overlap, contacts);
 }
 
 template <bool Rolling>
@@ -81,51 +82,43 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
 }
 
 template <bool Rolling>
-void HertzMindlin::walls(ContactContext& ctx) const {
-  DemParticles& p = ctx.particles;
+void HertzMindlin::walls(ContactContext& ctx, long i, Vector3d& force, Vector3d& torque,
+                         double& max_overlap, long& contacts) const {
+  const DemParticles& p = ctx.particles;
   const NeighbourList& list = ctx.list;
   WallHistory& hist = ctx.wall_history;
-  const ContactParams params = material_.particle_wall;
-  const long n = static_cast<long>(p.size());
-  const double dt = ctx.dt;
+  const ContactParams& params = material_.particle_wall;
   constexpr int slots = WallHistory::slots;
-  double max_overlap = 0.0;
-  long contacts = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(max : max_overlap) reduction(+ : contacts) if (n >= kDemParallelMinParticles)
-  for (long i = 0; i < n; ++i) {
-    int new_wall[slots];
-    Vector3d new_shear[slots];
-    int used = 0;
-    const double ri = p.radius[i];
-    for (auto q = list.wall_start[i]; q < list.wall_start[i + 1]; ++q) {
-      const int k = static_cast<int>(list.wall_id[q]);
-      WallContact wc;
-      if (!ctx.walls.contact(k, p.x[i], ri, wc)) continue;
-      Vector3d shear = Vector3d::Zero();
-      for (int s = 0; s < slots; ++s)
-        if (hist.wall[i * slots + s] == k) { shear = hist.shear[i * slots + s]; break; }
-      const double delta = ri - wc.distance;
-      const Vector3d& nrm = wc.normal;
-      const Vector3d vc = p.v[i] - ri * p.omega[i].cross(nrm);
-      HertzMindlinContact c;
-      hertzMindlinContact<Rolling>(params, delta, nrm, vc, p.omega[i], p.mass[i], ri, dt, shear, c);
-      p.force[i] += c.force;
-      p.torque[i] += -ri * c.n_x_ft + c.roll;
-      if (used < slots) {
-        new_wall[used] = k;
-        new_shear[used] = shear;
-        ++used;
-      }
-      max_overlap = std::max(max_overlap, delta / ri);
-      ++contacts;
+  int new_wall[slots];
+  Vector3d new_shear[slots];
+  int used = 0;
+  const double ri = p.radius[i];
+  for (auto q = list.wall_start[i]; q < list.wall_start[i + 1]; ++q) {
+    const int k = static_cast<int>(list.wall_id[q]);
+    WallContact wc;
+    if (!ctx.walls.contact(k, p.x[i], ri, wc)) continue;
+    Vector3d shear = Vector3d::Zero();
+    for (int s = 0; s < slots; ++s)
+      if (hist.wall[i * slots + s] == k) { shear = hist.shear[i * slots + s]; break; }
+    const double delta = ri - wc.distance;
+    const Vector3d& nrm = wc.normal;
+    const Vector3d vc = p.v[i] - ri * p.omega[i].cross(nrm);
+    HertzMindlinContact c;
+    hertzMindlinContact<Rolling>(params, delta, nrm, vc, p.omega[i], p.mass[i], ri, ctx.dt, shear, c);
+    force += c.force;
+    torque += -ri * c.n_x_ft + c.roll;
+    if (used < slots) {
+      new_wall[used] = k;
+      new_shear[used] = shear;
+      ++used;
     }
-    for (int s = 0; s < slots; ++s) {
-      hist.wall[i * slots + s] = s < used ? new_wall[s] : -1;
-      if (s < used) hist.shear[i * slots + s] = new_shear[s];
-    }
+    max_overlap = std::max(max_overlap, delta / ri);
+    ++contacts;
   }
-  ctx.max_overlap_fraction = std::max(ctx.max_overlap_fraction, max_overlap);
-  ctx.wall_contacts += contacts;
+  for (int s = 0; s < slots; ++s) {
+    hist.wall[i * slots + s] = s < used ? new_wall[s] : -1;
+    if (s < used) hist.shear[i * slots + s] = new_shear[s];
+  }
 }
 
 }  // namespace rcfd

@@ -72,11 +72,14 @@ class HertzMindlin final : public ContactModel {
   std::string name() const override { return "hertz_mindlin"; }
   void setRollingModel(const RollingModel* rolling) override;
   void computePairs(ContactContext& ctx) const override;
-  void computeWalls(ContactContext& ctx) const override;
+  void computeWalls(ContactContext& ctx, long i, Eigen::Vector3d& force, Eigen::Vector3d& torque,
+                    double& max_overlap, long& contacts) const override;
 
  private:
   template <bool Rolling> void pairs(ContactContext& ctx) const;
-  template <bool Rolling> void walls(ContactContext& ctx) const;
+  template <bool Rolling>
+  void walls(ContactContext& ctx, long i, Eigen::Vector3d& force, Eigen::Vector3d& torque,
+             double& max_overlap, long& contacts) const;
   DemMaterial material_;
   bool rolling_ = false;
 };

@@ -29,6 +29,11 @@ class NeighbourList {
   /// True when a particle moved more than half the skin since the last build (or none was made).
   bool needsRebuild(const DemParticles& p) const;
 
+  /// Positions at the last build and the squared displacement (skin/2)^2 that triggers a rebuild,
+  /// for integrators that test the displacement while they move the particles.
+  const std::vector<Eigen::Vector3d>& positionsAtBuild() const { return x_at_build_; }
+  double rebuildDistance2() const { return 0.25 * skin_ * skin_; }
+
   /// Rebuilds pairs and wall candidates; keeps the tangential history of pairs listed before.
   void build(const DemParticles& p, const DemWalls& walls);
 
