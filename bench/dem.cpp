@@ -115,6 +115,9 @@ nlohmann::json run(const Options& opt) {
             << " list builds\n";
   double ymax = 0.0;
   for (const auto& x : dem.particles().x) ymax = std::max(ymax, x.y());
+  const DemTimings& tm = dem.timings();
+  std::cout << "phases [s]: drift " << tm.drift << ", list builds " << tm.build << ", pair forces "
+            << tm.pairs << ", gather + walls + kick " << tm.gather << "\n";
   return {{"particle_steps_per_s", rate},
           {"particles", n},
           {"steps", steps},
@@ -125,7 +128,9 @@ nlohmann::json run(const Options& opt) {
           {"list_builds", dem.neighbourList().builds()},
           {"max_overlap_fraction", dem.maxOverlapFractionSeen()},
           {"bed_top_m", ymax},
-          {"kinetic_energy_j", dem.particles().kineticEnergy()}};
+          {"kinetic_energy_j", dem.particles().kineticEnergy()},
+          {"phase_seconds", {{"drift", tm.drift}, {"build", tm.build}, {"pairs", tm.pairs},
+                             {"gather_walls_kick", tm.gather}}}};
 }
 
 const bool registered = addBenchmark(

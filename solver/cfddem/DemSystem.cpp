@@ -1,6 +1,7 @@
 #include "cfddem/DemSystem.hpp"
 #include "cfddem/DemParallel.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
@@ -10,6 +11,12 @@
 namespace rcfd {
 
 using Eigen::Vector3d;
+
+namespace {
+double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+}  // namespace
 
 DemSettings DemSystem::settingsFromScene(const Scene& scene) {
   DemSettings s;
@@ -51,12 +58,16 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   if (wall_history_.wall.size() != particles_.size() * WallHistory::slots) resizeState();
   const bool rebuild = moved < 0 ? list_.needsRebuild(particles_)
                                  : (moved > 0 || list_.positionsAtBuild().size() != particles_.size());
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
   if (rebuild) {
     list_.build(particles_, walls_);
     pair_forces_.resize(list_.pairs());
   }
+  const auto t1 = Clock::now();
   ContactContext ctx{particles_, list_, walls_, wall_history_, pair_forces_, settings_.time_step};
   model_->computePairs(ctx);
+  const auto t2 = Clock::now();
   const long n = static_cast<long>(particles_.size());
   const Vector3d g = settings_.gravity;
   const double h = 0.5 * settings_.time_step;
@@ -87,6 +98,9 @@ void DemSystem::computeForces(bool final_kick, int moved) {
       p.omega[i] += (h * p.inv_inertia[i]) * t;
     }
   }
+  timings_.build += seconds(t0, t1);
+  timings_.pairs += seconds(t1, t2);
+  timings_.gather += seconds(t2, Clock::now());
   ctx.max_overlap_fraction = std::max(ctx.max_overlap_fraction, max_overlap);
   ctx.wall_contacts += wall_contacts;
   stats_ = DemStepStats{ctx.max_overlap_fraction, ctx.contacts, ctx.wall_contacts};
@@ -111,6 +125,7 @@ void DemSystem::step() {
   const bool have_build = x_build.size() == p.size();
   const double limit2 = list_.rebuildDistance2();
   int moved = have_build ? 0 : 1;
+  const auto t0 = std::chrono::steady_clock::now();
 #pragma omp parallel for schedule(static) reduction(| : moved) if (n >= kDemParallelMinParticles)
   for (long i = 0; i < n; ++i) {
     p.v[i] += (h * p.inv_mass[i]) * p.force[i];
@@ -118,6 +133,7 @@ void DemSystem::step() {
     p.x[i] += dt * p.v[i];
     if (have_build) moved |= (p.x[i] - x_build[i]).squaredNorm() > limit2 ? 1 : 0;
   }
+  timings_.drift += seconds(t0, std::chrono::steady_clock::now());
   computeForces(true, moved);
   time_ += dt;
   ++steps_;

@@ -29,6 +29,14 @@ struct DemSettings {
   std::string rolling_model;               ///< empty: no rolling friction; else e.g. "cdt"
 };
 
+/// Wall-clock seconds spent in each phase since construction (for benchmarks).
+struct DemTimings {
+  double drift = 0.0;   ///< first half kick and drift (with the displacement test)
+  double build = 0.0;   ///< neighbour-list rebuilds
+  double pairs = 0.0;   ///< particle-particle forces into per-pair slots
+  double gather = 0.0;  ///< per-particle gather, wall contacts and the second half kick
+};
+
 /// Figures of the last step.
 struct DemStepStats {
   double max_overlap_fraction = 0.0;  ///< largest delta / r [-]
@@ -69,6 +77,7 @@ class DemSystem {
   /// dt / t_Rayleigh, reported when the system is built [-].
   double rayleighFraction() const { return rayleigh_fraction_; }
   const DemStepStats& lastStats() const { return stats_; }
+  const DemTimings& timings() const { return timings_; }
   /// Largest overlap fraction seen since construction [-].
   double maxOverlapFractionSeen() const { return max_overlap_seen_; }
 
@@ -93,6 +102,7 @@ class DemSystem {
   WallHistory wall_history_;
   PairForces pair_forces_;
   DemStepStats stats_;
+  DemTimings timings_;
   double time_ = 0.0;
   long steps_ = 0;
   double rayleigh_fraction_ = 0.0;

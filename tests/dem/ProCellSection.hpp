@@ -12,6 +12,8 @@ namespace rcfd::demtest {
 struct ProCell {
   ApparatusSpec spec;
   bool plates = true;
+  DraftPlatesSpec plate;  ///< elevation 0.03 m: plates clear of the V, all four edges exposed
+  ProCell() { plate.elevation = 0.03; }
   double wi() const { return 0.5 * spec.inlet_width; }
   double yv() const {
     return (0.5 * spec.width - wi()) * std::tan(spec.prism_angle_deg * M_PI / 180.0);
@@ -23,7 +25,7 @@ struct ProCell {
   /// Plate rectangles as (x0, y0, x1, y1).
   std::vector<Eigen::Vector4d> plateRects() const {
     if (!plates) return {};
-    const DraftPlatesSpec p;
+    const DraftPlatesSpec& p = plate;
     const double x0 = 0.5 * p.gap, x1 = x0 + p.thickness, y0 = p.elevation, y1 = y0 + p.height;
     return {{x0, y0, x1, y1}, {-x1, y0, -x0, y1}};
   }

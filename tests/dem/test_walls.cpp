@@ -21,10 +21,12 @@ DemMaterial paperParcel() { return material(kR, 0.9, 0.75, 0.5, 0.24, 0.06, 0.05
 
 TEST(ApparatusWalls, PrimitivesOfTheProCell) {
   ProCell cell;
+  cell.plate.elevation = 0.01;
   const DemWalls walls = wallsFromSection(cell.edges(), cell.spec.depth);
   EXPECT_EQ(walls.faces().size(), 6u + 8u + 2u);  // outline, plate sides, z = 0 and z = depth
   EXPECT_EQ(walls.edges().size(), 8u);            // the plates' long edges; the outline is convex
   int checked = 0;
+  cell.plate.elevation = 0.01;  // the scene default: the plates' lower ends inside the V walls
   for (const auto& f : walls.faces()) {
     if (!std::isfinite(f.a_max)) continue;
     // Every normal points into the open region. (With the default plates the plates' lower ends lie
@@ -89,7 +91,6 @@ TEST(ApparatusWalls, ImpactsAt20MetresPerSecondNeverPassAWall) {
   const double w = 0.5 * cell.spec.width;
   const auto p = cell.plateRects()[0];
   const double z = 0.1;
-  auto yV = [&](double x) { return (x - cell.wi()) * std::tan(M_PI / 3); };
   std::vector<Vector3d> targets = {
       {0.0, 0.0, z},                                  // inlet (a wall for particles)
       {cell.wi(), 0.0, z},                            // inlet / V wall corner
@@ -101,7 +102,8 @@ TEST(ApparatusWalls, ImpactsAt20MetresPerSecondNeverPassAWall) {
       {p[2], 0.5 * (p[1] + p[3]), z},                 // plate outer face
       {p[0], p[3], z}, {p[2], p[3], z},               // plate top edges (convex)
       {0.5 * (p[0] + p[2]), p[3], z},                 // plate top
-      {p[0], yV(p[0]), z}, {p[2], yV(p[2]), z},       // plates emerging from the V wall (concave)
+      {p[0], p[1], z}, {p[2], p[1], z},               // plate bottom edges (convex)
+      {0.5 * (p[0] + p[2]), p[1], z},                 // plate bottom
       {0.1, 0.3, 0.0},                                // z = 0 face
       {w, 0.3, 0.0},                                  // side wall / z face corner
       {cell.wi(), 0.0, 0.0},                          // triple corner at the inlet
