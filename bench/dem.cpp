@@ -2,6 +2,7 @@
 // with tangential history, cdt rolling friction) in a box; figure: particle steps per second.
 // The same initial state is written for LIGGGHTS (bench/liggghts/, docs/performance.md).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -135,6 +136,82 @@ nlohmann::json run(const Options& opt) {
 
 const bool registered = addBenchmark(
     "dem", "dense settling bed of 20,000 spheres, Hertz-Mindlin + history + cdt rolling friction", run);
+
+}  // namespace
+}  // namespace rcfd::bench
+
+// rcfd-bench dem-procell: the acceptance case of issue 6, 1.5 kg of the paper's particles at cg = 3
+// (17,493 parcels) poured into the ProCell (no draft plates, the scene default) from the paper's
+// region 0.2 m < y < 0.3 m and settled; reports parcels outside the walls or inside the inlet.
+#include "cfddem/ApparatusWalls.hpp"
+#include "cfddem/DemFilling.hpp"
+
+namespace rcfd::bench {
+namespace {
+
+/// The prismatic spouted bed's cross-section from its spec (the same polygon as Apparatus.cpp);
+/// to be replaced by wallsFromApparatus(Apparatus(spec)) once the geometry module is on main.
+std::vector<SectionEdge> prismaticSection(const ApparatusSpec& a) {
+  const double wi = 0.5 * a.inlet_width, w = 0.5 * a.width;
+  const double yv = (w - wi) * std::tan(a.prism_angle_deg * M_PI / 180.0);
+  const std::vector<Eigen::Vector2d> o = {{-wi, 0.0}, {wi, 0.0}, {w, yv}, {w, a.height},
+                                          {-w, a.height}, {-w, yv}};
+  std::vector<SectionEdge> e;
+  for (std::size_t i = 0; i < o.size(); ++i) e.push_back({o[i], o[(i + 1) % o.size()]});
+  return e;
+}
+
+nlohmann::json runProCell(const Options& opt) {
+  spdlog::set_level(spdlog::level::info);
+  Scene scene;
+  scene.dem.coarse_graining = opt.quick ? 8.0 : 3.0;
+  const DemMaterial m = DemMaterial::fromScene(scene);
+  DemSettings s = DemSystem::settingsFromScene(scene);
+  s.rolling_model = "cdt";
+  s.time_step = 0.25 * m.rayleighTime();  // the paper's 1 us would take 50x longer to settle
+  const auto section = prismaticSection(scene.apparatus);
+  DemSystem dem(m, wallsFromSection(section, scene.apparatus.depth), s);
+  const long n = parcelsForBedMass(scene);
+  const auto t0 = std::chrono::steady_clock::now();
+  FillOptions fo;
+  fo.max_settle_time = 1.0;
+  const FillResult r = fillAndSettle(dem, defaultFillRegion(scene.apparatus), n, fo);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Independent check against the polygon: every centre at least one radius inside, none below y=0.
+  long outside = 0, in_inlet = 0;
+  double top = 0.0, mass = 0.0, min_clear = 1.0;
+  for (std::size_t i = 0; i < dem.particles().size(); ++i) {
+    const Vector3d& x = dem.particles().x[i];
+    double c = std::min(x.z(), scene.apparatus.depth - x.z());
+    for (const auto& e : section) {
+      const Eigen::Vector2d t = (e.b - e.a).normalized();
+      c = std::min(c, (Eigen::Vector2d(x.x(), x.y()) - e.a).dot(Eigen::Vector2d(-t.y(), t.x())));
+    }
+    min_clear = std::min(min_clear, c / m.particle_radius);
+    if (c < 0.0) ++outside;
+    if (x.y() < 0.0) ++in_inlet;
+    top = std::max(top, x.y());
+    mass += dem.particles().mass[i];
+  }
+  std::cout << "dem-procell: " << r.inserted << " parcels (cg " << scene.dem.coarse_graining << ", "
+            << mass << " kg) in " << r.batches << " batches, " << r.fill_time << " s falling + "
+            << r.settle_time << " s settling (" << (r.settled ? "settled" : "time limit") << "), "
+            << dem.steps() << " steps in " << wall << " s; bed top y = " << top << " m; " << outside
+            << " outside the walls, " << in_inlet << " in the inlet; closest centre "
+            << min_clear << " r from a wall\n";
+  return {{"parcels", r.inserted}, {"coarse_graining", scene.dem.coarse_graining},
+          {"bed_mass_kg", mass}, {"batches", r.batches}, {"fill_time_s", r.fill_time},
+          {"settle_time_s", r.settle_time}, {"settled", r.settled}, {"steps", dem.steps()},
+          {"time_step_s", s.time_step}, {"rayleigh_fraction", dem.rayleighFraction()},
+          {"wall_time_s", wall}, {"bed_top_m", top}, {"outside_walls", outside},
+          {"in_inlet", in_inlet}, {"closest_centre_over_radius", min_clear},
+          {"max_overlap_fraction", dem.maxOverlapFractionSeen()},
+          {"particle_steps_per_s", static_cast<double>(dem.particles().size()) * dem.steps() / wall}};
+}
+
+const bool registered_procell = addBenchmark(
+    "dem-procell", "1.5 kg at cg = 3 poured into the ProCell and settled (issue 6 acceptance)",
+    runProCell);
 
 }  // namespace
 }  // namespace rcfd::bench
