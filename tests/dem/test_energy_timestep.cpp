@@ -37,6 +37,7 @@ TEST(Energy, ConservedWithoutDampingOrFriction) {
     if (k % 10 == 0) worst = std::max(worst, std::abs(dem.totalEnergy() - e0));
   }
   EXPECT_GT(contacts, 1000) << "the particles must actually collide";
+  RecordProperty("relative_energy_error", std::to_string(worst / scale));
   EXPECT_LT(worst / scale, 1e-4);
 }
 
@@ -83,6 +84,29 @@ TEST(TimeStep, WarnsOnceWhenOverlapExceedsLimit) {
   dem.addParticle(Vector3d(0, 0.01, 0), Vector3d(0, -2, 0));
   dem.run(1000);
   EXPECT_GT(dem.maxOverlapFractionSeen(), 0.003);
+}
+
+}  // namespace
+}  // namespace rcfd
+
+namespace rcfd {
+namespace {
+
+TEST(Effects, RollingFrictionOnlyWhenTheSceneAsksForIt) {
+  Scene scene;
+  scene.dem.time_step = 1e-6;
+  scene.effects = {"walls"};
+  DemSettings without = DemSystem::settingsFromScene(scene);
+  EXPECT_TRUE(without.rolling_model.empty());
+  DemSystem a(DemMaterial::fromScene(scene), DemWalls(), without);
+  EXPECT_FALSE(a.hasRollingModel()) << "not asked for: not constructed";
+  scene.effects.push_back("rolling_friction");
+  DemSettings with = DemSystem::settingsFromScene(scene);
+  EXPECT_EQ(with.rolling_model, "cdt");
+  DemSystem b(DemMaterial::fromScene(scene), DemWalls(), with);
+  EXPECT_TRUE(b.hasRollingModel());
+  EXPECT_TRUE(ContactModelRegistry::contains("hertz_mindlin"));
+  EXPECT_TRUE(RollingModelRegistry::contains("cdt"));
 }
 
 }  // namespace

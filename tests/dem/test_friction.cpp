@@ -89,6 +89,7 @@ TEST(RollingFriction, StopsRollingSphereAtAnalyticDistance) {
   long k = 0;
   while (p.v[0].x() > 0.0 && k++ < 200000) dem.step();
   const double expected = 7.0 * v0 * v0 / (10.0 * mu_r * kG);
+  RecordProperty("distance_over_analytic", std::to_string((p.x[0].x() - x0) / expected));
   EXPECT_NEAR(p.x[0].x() - x0, expected, 0.05 * expected);
 }
 

@@ -57,6 +57,7 @@ TEST_P(Restitution, SphereOnWallRecoversE) {
   const DemMaterial m = material(kRadius, 0.9, e);
   const double tc = hertzDuration(sphereMass(m), kRadius, m.particle_wall.y_eff, kSpeed);
   const auto [ratio, duration] = wallImpact(m, tc / 400);
+  RecordProperty("restitution", std::to_string(ratio));
   EXPECT_NEAR(ratio, e, 0.01 * e);
 }
 
@@ -65,6 +66,7 @@ TEST_P(Restitution, SphereOnSphereRecoversE) {
   const DemMaterial m = material(kRadius, e, 0.75);
   const double tc = hertzDuration(0.5 * sphereMass(m), 0.5 * kRadius, m.particle_particle.y_eff, kSpeed);
   const auto [ratio, duration] = pairImpact(m, tc / 400);
+  RecordProperty("restitution", std::to_string(ratio));
   EXPECT_NEAR(ratio, e, 0.01 * e);
 }
 
@@ -74,6 +76,7 @@ TEST(HertzContact, DurationOnWallMatchesAnalytic) {
   const DemMaterial m = material(kRadius, 1.0, 1.0);
   const double tc = hertzDuration(sphereMass(m), kRadius, m.particle_wall.y_eff, kSpeed);
   const auto [ratio, duration] = wallImpact(m, tc / 500);
+  RecordProperty("duration_over_analytic", std::to_string(duration / tc));
   EXPECT_NEAR(duration, tc, 0.02 * tc);
   EXPECT_NEAR(ratio, 1.0, 1e-3) << "undamped impact is elastic";
 }
@@ -82,6 +85,7 @@ TEST(HertzContact, DurationBetweenSpheresMatchesAnalytic) {
   const DemMaterial m = material(kRadius, 1.0, 1.0);
   const double tc = hertzDuration(0.5 * sphereMass(m), 0.5 * kRadius, m.particle_particle.y_eff, kSpeed);
   const auto [ratio, duration] = pairImpact(m, tc / 500);
+  RecordProperty("duration_over_analytic", std::to_string(duration / tc));
   EXPECT_NEAR(duration, tc, 0.02 * tc);
 }
 
