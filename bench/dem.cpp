@@ -141,7 +141,7 @@ const bool registered = addBenchmark(
 }  // namespace rcfd::bench
 
 // rcfd-bench dem-procell: the acceptance case of issue 6, 1.5 kg of the paper's particles at cg = 3
-// (17,493 parcels) poured into the ProCell (no draft plates, the scene default) from the paper's
+// (17,494 parcels) poured into the ProCell (no draft plates, the scene default) from the paper's
 // region 0.2 m < y < 0.3 m and settled; reports parcels outside the walls or inside the inlet.
 #include "cfddem/ApparatusWalls.hpp"
 #include "cfddem/DemFilling.hpp"

@@ -70,7 +70,7 @@ TEST(Bed, PouredBedPacksBetween058And064) {
 
 TEST(Bed, ProCellSettlesIntoTheVWithNothingOutside) {
   // 1.5 kg of the paper's particles as cg = 8 parcels (about 920), to keep the test short; cg = 3
-  // (17,493 parcels) runs the same code in `rcfd-bench dem-procell` (docs/performance.md).
+  // (17,494 parcels) runs the same code in `rcfd-bench dem-procell` (docs/performance.md).
   Scene scene;
   scene.dem.coarse_graining = 8.0;
   ProCell cell;
