@@ -3,6 +3,7 @@
 // The same initial state is written for LIGGGHTS (bench/liggghts/, docs/performance.md).
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -104,7 +105,12 @@ nlohmann::json run(const Options& opt) {
     std::cout << "wrote the initial state for LIGGGHTS to " << path << "\n";
   }
   DemSystem dem(benchMaterial(c), DemWalls::box(c.lo(), c.hi()), benchSettings(c.dt));
-  for (const auto& x : bed) dem.addParticle(x);
+  std::vector<std::size_t> order(bed.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  // RCFD_BENCH_DEM_SHUFFLE=1: random particle order, as after random insertion and mixing.
+  if (const char* sh = std::getenv("RCFD_BENCH_DEM_SHUFFLE"); sh && std::string(sh) == "1")
+    std::shuffle(order.begin(), order.end(), std::mt19937_64(1));
+  for (std::size_t i : order) dem.addParticle(bed[i]);
   const long n = static_cast<long>(dem.particles().size());
   const auto t0 = std::chrono::steady_clock::now();
   dem.run(steps);

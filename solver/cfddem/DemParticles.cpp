@@ -15,10 +15,28 @@ std::size_t DemParticles::add(const Vec3& pos, const Vec3& vel, double r, double
   mass.push_back(m);
   inv_mass.push_back(1.0 / m);
   inv_inertia.push_back(1.0 / (0.4 * m * r * r));
+  id.push_back(id.size());
   return x.size() - 1;
 }
 
+namespace {
+template <class T>
+void applyPermutation(std::vector<T>& a, const std::vector<std::size_t>& perm) {
+  std::vector<T> out(a.size());
+  for (std::size_t k = 0; k < perm.size(); ++k) out[k] = a[perm[k]];
+  a.swap(out);
+}
+}  // namespace
+
+void DemParticles::permute(const std::vector<std::size_t>& perm) {
+  applyPermutation(x, perm); applyPermutation(v, perm); applyPermutation(omega, perm);
+  applyPermutation(force, perm); applyPermutation(torque, perm); applyPermutation(radius, perm);
+  applyPermutation(mass, perm); applyPermutation(inv_mass, perm); applyPermutation(inv_inertia, perm);
+  applyPermutation(id, perm);
+}
+
 void DemParticles::reserve(std::size_t n) {
+  id.reserve(n);
   x.reserve(n); v.reserve(n); omega.reserve(n); force.reserve(n); torque.reserve(n);
   radius.reserve(n); mass.reserve(n); inv_mass.reserve(n); inv_inertia.reserve(n);
 }

@@ -2,11 +2,13 @@
 /// \file DemParticles.hpp
 /// The DEM particles (or coarse-grained parcels) as a structure of arrays: one array per quantity, so
 /// the force and integration loops stream through memory. Index i is a particle's identity for its
-/// whole life (no reordering), which keys the tangential contact history.
+/// life until DemSystem sorts the particles spatially (for cache locality); `id` is the permanent
+/// identity (the order of insertion).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace rcfd {
@@ -21,6 +23,9 @@ class DemParticles {
 
   std::size_t size() const { return x.size(); }
   void reserve(std::size_t n);
+
+  /// Reorders all arrays: new index k holds the particle that was at perm[k].
+  void permute(const std::vector<std::size_t>& perm);
 
   /// Prevents particle i from rotating (infinite moment of inertia): a sliding block in tests.
   void lockRotation(std::size_t i) { inv_inertia[i] = 0.0; }
@@ -39,6 +44,7 @@ class DemParticles {
   std::vector<double> mass;   ///< [kg]
   std::vector<double> inv_mass;     ///< 1/m [1/kg]
   std::vector<double> inv_inertia;  ///< 1/I [1/(kg m2)]; 0 locks the rotation
+  std::vector<std::uint64_t> id;    ///< identity: insertion order, kept through spatial sorts
 };
 
 }  // namespace rcfd

@@ -2,6 +2,7 @@
 #include "cfddem/DemParallel.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
@@ -54,6 +55,47 @@ void DemSystem::resizeState() {
   wall_history_.resize(particles_.size());
 }
 
+void DemSystem::sortParticles() {
+  DemParticles& p = particles_;
+  const std::size_t n = p.size();
+  if (n == 0) return;
+  Vector3d lo = p.x[0], hi = p.x[0];
+  double r_max = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(p.x[i]);
+    hi = hi.cwiseMax(p.x[i]);
+    r_max = std::max(r_max, p.radius[i]);
+  }
+  // Cells of the list's size, ordered x fastest, then z, then y (layers of a bed); ties keep the
+  // current order, so the permutation depends on the positions only (deterministic).
+  const double cell = 2.0 * r_max + list_.skin();
+  long nc[3];
+  for (int a = 0; a < 3; ++a)
+    nc[a] = std::clamp(static_cast<long>((hi[a] - lo[a]) / cell) + 1, 1L, 1L << 20);
+  std::vector<std::uint64_t> key(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    long c[3];
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp(static_cast<long>((p.x[i][a] - lo[a]) / cell), 0L, nc[a] - 1);
+    key[i] = (static_cast<std::uint64_t>(c[1]) * nc[2] + c[2]) * nc[0] + c[0];
+  }
+  std::vector<std::size_t> perm(n);
+  for (std::size_t i = 0; i < n; ++i) perm[i] = i;
+  std::stable_sort(perm.begin(), perm.end(),
+                   [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  p.permute(perm);
+  list_.permute(perm);
+  const int slots = WallHistory::slots;
+  WallHistory h;
+  h.resize(n);
+  for (std::size_t k = 0; k < n; ++k)
+    for (int s = 0; s < slots; ++s) {
+      h.wall[k * slots + s] = wall_history_.wall[perm[k] * slots + s];
+      h.shear[k * slots + s] = wall_history_.shear[perm[k] * slots + s];
+    }
+  wall_history_ = std::move(h);
+}
+
 void DemSystem::computeForces(bool final_kick, int moved) {
   if (wall_history_.wall.size() != particles_.size() * WallHistory::slots) resizeState();
   const bool rebuild = moved < 0 ? list_.needsRebuild(particles_)
@@ -61,6 +103,11 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   if (rebuild) {
+    if (settings_.sort_interval > 0 && static_cast<long>(particles_.size()) >= kDemSortMinParticles &&
+        ++builds_since_sort_ >= settings_.sort_interval) {
+      sortParticles();
+      builds_since_sort_ = 0;
+    }
     list_.build(particles_, walls_);
     pair_forces_.resize(list_.pairs());
   }

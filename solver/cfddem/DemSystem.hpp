@@ -19,12 +19,19 @@
 
 namespace rcfd {
 
+/// Smaller systems are never sorted: they fit in cache, and tests address particles by index.
+inline constexpr long kDemSortMinParticles = 1024;
+
 struct DemSettings {
   double time_step = 1e-6;                 ///< dt_DEM [s]
   Eigen::Vector3d gravity = Eigen::Vector3d(0.0, -9.81, 0.0);  ///< [m/s2]
   double skin_fraction = 0.4;              ///< neighbour-list skin as a fraction of the parcel radius
   double max_rayleigh_fraction = 0.3;      ///< dt above this fraction of the Rayleigh time: refused
   double max_overlap_fraction = 0.003;     ///< warn when an overlap exceeds this fraction of r
+  /// Sort the particles spatially (cell order) every this many list builds, for cache locality
+  /// (a random order costs a factor of about 1.8); 0: never. Only systems of at least
+  /// kDemSortMinParticles particles are sorted. Indices change; DemParticles::id does not.
+  int sort_interval = 10;
   std::string contact_model = "hertz_mindlin";
   std::string rolling_model;               ///< empty: no rolling friction; else e.g. "cdt"
 };
@@ -91,6 +98,7 @@ class DemSystem {
   /// moved: 1/0 whether the caller found a displacement above half the skin, -1 to test here.
   void computeForces(bool final_kick, int moved);
   void resizeState();
+  void sortParticles();
 
   DemMaterial material_;
   DemWalls walls_;
@@ -105,6 +113,7 @@ class DemSystem {
   DemTimings timings_;
   double time_ = 0.0;
   long steps_ = 0;
+  long builds_since_sort_ = 0;
   double rayleigh_fraction_ = 0.0;
   double max_overlap_seen_ = 0.0;
   bool forces_valid_ = false;

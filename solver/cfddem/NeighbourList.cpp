@@ -21,6 +21,37 @@ bool NeighbourList::needsRebuild(const DemParticles& p) const {
   return moved != 0;
 }
 
+void NeighbourList::permute(const std::vector<std::size_t>& perm) {
+  const std::size_t n = perm.size();
+  if (row_start.size() != n + 1) return;
+  std::vector<Index> inv(n);
+  for (std::size_t k = 0; k < n; ++k) inv[perm[k]] = static_cast<Index>(k);
+  struct Entry {
+    Index i, j;
+    Vector3d shear;
+  };
+  std::vector<Entry> e;
+  e.reserve(j.size());
+  for (std::size_t i = 0; i < n; ++i)
+    for (Index q = row_start[i]; q < row_start[i + 1]; ++q) {
+      Index a = inv[i], b = inv[j[q]];
+      // The history is the first body's displacement relative to the second: swap -> negate.
+      if (a < b) e.push_back({a, b, shear[q]});
+      else e.push_back({b, a, -shear[q]});
+    }
+  std::sort(e.begin(), e.end(), [](const Entry& x, const Entry& y) {
+    return x.i != y.i ? x.i < y.i : x.j < y.j;
+  });
+  std::fill(row_start.begin(), row_start.end(), 0);
+  for (std::size_t q = 0; q < e.size(); ++q) {
+    ++row_start[e[q].i + 1];
+    j[q] = e[q].j;
+    shear[q] = e[q].shear;
+  }
+  for (std::size_t i = 0; i < n; ++i) row_start[i + 1] += row_start[i];
+  x_at_build_.clear();  // forces a rebuild
+}
+
 void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
   const long n = static_cast<long>(p.size());
   ++builds_;

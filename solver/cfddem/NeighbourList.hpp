@@ -37,6 +37,11 @@ class NeighbourList {
   /// Rebuilds pairs and wall candidates; keeps the tangential history of pairs listed before.
   void build(const DemParticles& p, const DemWalls& walls);
 
+  /// Re-expresses the list (and its tangential history) after the particles were reordered: new
+  /// index k is old index perm[k]. Pairs whose order flips get the opposite history. The next
+  /// build() must follow (the list is no longer sorted for the new positions).
+  void permute(const std::vector<std::size_t>& perm);
+
   std::size_t pairs() const { return j.size(); }
   long builds() const { return builds_; }
 
