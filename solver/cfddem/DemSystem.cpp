@@ -104,9 +104,8 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   const auto t0 = Clock::now();
   if (rebuild) {
     if (settings_.sort_interval > 0 && static_cast<long>(particles_.size()) >= kDemSortMinParticles &&
-        ++builds_since_sort_ >= settings_.sort_interval) {
-      sortParticles();
-      builds_since_sort_ = 0;
+        builds_since_sort_++ % settings_.sort_interval == 0) {
+      sortParticles();  // at the first build, then every sort_interval builds
     }
     list_.build(particles_, walls_);
     pair_forces_.resize(list_.pairs());
