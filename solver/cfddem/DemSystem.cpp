@@ -47,8 +47,12 @@ DemSystem::DemSystem(const DemMaterial& material, DemWalls walls, const DemSetti
 }
 
 std::size_t DemSystem::addParticle(const Vector3d& x, const Vector3d& v) {
-  forces_valid_ = false;
-  return particles_.add(x, v, material_.particle_radius, material_.density);
+  const std::size_t i = particles_.add(x, v, material_.particle_radius, material_.density);
+  // Until the next force evaluation a new particle feels gravity only (it is inserted clear of
+  // others); the particles already there keep their forces, so no contact history is advanced twice.
+  particles_.force[i] = particles_.mass[i] * settings_.gravity;
+  particles_.torque[i].setZero();
+  return i;
 }
 
 void DemSystem::resizeState() {
@@ -111,7 +115,10 @@ void DemSystem::computeForces(bool final_kick, int moved) {
     pair_forces_.resize(list_.pairs());
   }
   const auto t1 = Clock::now();
-  ContactContext ctx{particles_, list_, walls_, wall_history_, pair_forces_, settings_.time_step};
+  // The set-up evaluation before the first step does not advance the tangential history (as
+  // LIGGGHTS' setup with shearupdate off).
+  ContactContext ctx{particles_, list_, walls_, wall_history_, pair_forces_,
+                     forces_valid_ ? settings_.time_step : 0.0};
   model_->computePairs(ctx);
   const auto t2 = Clock::now();
   const long n = static_cast<long>(particles_.size());
