@@ -51,6 +51,10 @@ DemSettings benchSettings(double dt) {
   s.rolling_model = "cdt";
   s.max_overlap_fraction = 1.0;
   s.skin_fraction = 0.4;
+  // RCFD_BENCH_DEM_DIRECT=1 (with --threads 1): the serial reference scheme without the
+  // deterministic per-pair gather, to measure what determinism costs.
+  if (const char* d = std::getenv("RCFD_BENCH_DEM_DIRECT"); d && std::string(d) == "1")
+    s.serial_direct_accumulation = true;
   return s;
 }
 

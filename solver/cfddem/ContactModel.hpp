@@ -45,6 +45,9 @@ struct ContactContext {
   WallHistory& wall_history;
   PairForces& pair_forces;
   double dt;                        ///< DEM time step [s] (tangential history increments)
+  /// Serial reference mode (benchmarks only): the pair loop adds straight into the particles'
+  /// accumulators (pre-set with gravity) instead of per-pair slots; one thread, no gather.
+  bool direct = false;
   double max_overlap_fraction = 0;  ///< out: largest delta / r of any contact this evaluation
   long contacts = 0;                ///< out: number of touching particle-particle pairs
   long wall_contacts = 0;           ///< out: number of particle-wall contacts

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <omp.h>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 
@@ -119,12 +120,19 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   // LIGGGHTS' setup with shearupdate off).
   ContactContext ctx{particles_, list_, walls_, wall_history_, pair_forces_,
                      forces_valid_ ? settings_.time_step : 0.0};
-  model_->computePairs(ctx);
-  const auto t2 = Clock::now();
   const long n = static_cast<long>(particles_.size());
   const Vector3d g = settings_.gravity;
   const double h = 0.5 * settings_.time_step;
   DemParticles& p = particles_;
+  ctx.direct = settings_.serial_direct_accumulation && omp_get_max_threads() == 1;
+  if (ctx.direct)
+    for (long i = 0; i < n; ++i) {
+      p.force[i] = p.mass[i] * g;
+      p.torque[i].setZero();
+    }
+  model_->computePairs(ctx);
+  const auto t2 = Clock::now();
+  const bool gather_pairs = !ctx.direct;
   double max_overlap = 0.0;
   long wall_contacts = 0;
   // Gather in a fixed order (own pairs, then pairs as second member, then walls): independent of
@@ -133,14 +141,19 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   for (long i = 0; i < n; ++i) {
     Vector3d f = p.mass[i] * g;
     Vector3d t = Vector3d::Zero();
-    for (auto q = list_.row_start[i]; q < list_.row_start[i + 1]; ++q) {
-      f += pair_forces_.force[q];
-      t += pair_forces_.torque_i[q];
-    }
-    for (auto c = list_.col_start[i]; c < list_.col_start[i + 1]; ++c) {
-      const auto q = list_.col_pair[c];
-      f -= pair_forces_.force[q];
-      t += pair_forces_.torque_j[q];
+    if (gather_pairs) {
+      for (auto q = list_.row_start[i]; q < list_.row_start[i + 1]; ++q) {
+        f += pair_forces_.force[q];
+        t += pair_forces_.torque_i[q];
+      }
+      for (auto c = list_.col_start[i]; c < list_.col_start[i + 1]; ++c) {
+        const auto q = list_.col_pair[c];
+        f -= pair_forces_.force[q];
+        t += pair_forces_.torque_j[q];
+      }
+    } else {
+      f = p.force[i];
+      t = p.torque[i];
     }
     if (list_.wall_start[i] != list_.wall_start[i + 1])
       model_->computeWalls(ctx, i, f, t, max_overlap, wall_contacts);

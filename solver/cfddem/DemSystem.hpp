@@ -32,6 +32,10 @@ struct DemSettings {
   /// (a random order costs a factor of about 1.8); 0: never. Only systems of at least
   /// kDemSortMinParticles particles are sorted. Indices change; DemParticles::id does not.
   int sort_interval = 10;
+  /// Benchmarks only: the serial reference scheme (pair forces added straight into the particles,
+  /// one thread) to measure what the deterministic per-pair gather costs. Ignored (with the
+  /// deterministic scheme used) when more than one OpenMP thread is available.
+  bool serial_direct_accumulation = false;
   std::string contact_model = "hertz_mindlin";
   std::string rolling_model;               ///< empty: no rolling friction; else e.g. "cdt"
 };

@@ -24,8 +24,13 @@ void HertzMindlin::setRollingModel(const RollingModel* rolling) {
 }
 
 void HertzMindlin::computePairs(ContactContext& ctx) const {
-  if (rolling_) pairs<true>(ctx);
-  else pairs<false>(ctx);
+  if (ctx.direct) {
+    if (rolling_) pairs<true, true>(ctx);
+    else pairs<false, true>(ctx);
+  } else {
+    if (rolling_) pairs<true, false>(ctx);
+    else pairs<false, false>(ctx);
+  }
 }
 
 void HertzMindlin::computeWalls(ContactContext& ctx, long i, Vector3d& force, Vector3d& torque,
@@ -34,9 +39,9 @@ void HertzMindlin::computeWalls(ContactContext& ctx, long i, Vector3d& force, Ve
   else walls<false>(ctx, i, force, torque, max_overlap, contacts);
 }
 
-template <bool Rolling>
+template <bool Rolling, bool Direct>
 void HertzMindlin::pairs(ContactContext& ctx) const {
-  const DemParticles& p = ctx.particles;
+  DemParticles& p = ctx.particles;
   NeighbourList& list = ctx.list;
   PairForces& out = ctx.pair_forces;
   const ContactParams params = material_.particle_particle;
@@ -44,7 +49,7 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
   const double dt = ctx.dt;
   double max_overlap = 0.0;
   long contacts = 0;
-#pragma omp parallel for schedule(dynamic, 128) reduction(max : max_overlap) reduction(+ : contacts) if (n >= kDemParallelMinParticles)
+#pragma omp parallel for schedule(dynamic, 128) reduction(max : max_overlap) reduction(+ : contacts) if (!Direct && n >= kDemParallelMinParticles)
   for (long i = 0; i < n; ++i) {
     const Vector3d xi = p.x[i], vi = p.v[i], wi = p.omega[i];
     const double ri = p.radius[i], mi = p.mass[i];
@@ -55,6 +60,7 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
       const double r2 = d.squaredNorm();
       if (r2 >= rsum * rsum) {
         list.shear[q].setZero();
+        if constexpr (Direct) continue;
         out.force[q].setZero();
         out.torque_i[q].setZero();
         out.torque_j[q].setZero();
@@ -70,9 +76,16 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
       HertzMindlinContact c;
       hertzMindlinContact<Rolling>(params, delta, nrm, vc, wi - p.omega[k], m_eff, r_eff, dt,
                                    list.shear[q], c);
-      out.force[q] = c.force;
-      out.torque_i[q] = -ri * c.n_x_ft + c.roll;
-      out.torque_j[q] = -rk * c.n_x_ft - c.roll;
+      if constexpr (Direct) {
+        p.force[i] += c.force;
+        p.force[k] -= c.force;
+        p.torque[i] += -ri * c.n_x_ft + c.roll;
+        p.torque[k] += -rk * c.n_x_ft - c.roll;
+      } else {
+        out.force[q] = c.force;
+        out.torque_i[q] = -ri * c.n_x_ft + c.roll;
+        out.torque_j[q] = -rk * c.n_x_ft - c.roll;
+      }
       max_overlap = std::max(max_overlap, delta / std::min(ri, rk));
       ++contacts;
     }

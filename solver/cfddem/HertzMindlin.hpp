@@ -76,7 +76,7 @@ class HertzMindlin final : public ContactModel {
                     double& max_overlap, long& contacts) const override;
 
  private:
-  template <bool Rolling> void pairs(ContactContext& ctx) const;
+  template <bool Rolling, bool Direct> void pairs(ContactContext& ctx) const;
   template <bool Rolling>
   void walls(ContactContext& ctx, long i, Eigen::Vector3d& force, Eigen::Vector3d& torque,
              double& max_overlap, long& contacts) const;

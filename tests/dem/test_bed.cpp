@@ -171,7 +171,7 @@ TEST(NeighbourList, TangentialHistorySurvivesRebuilds) {
 namespace rcfd {
 namespace {
 
-std::vector<Eigen::Vector3d> bedById(int sort_interval, long* builds) {
+std::vector<Eigen::Vector3d> bedById(int sort_interval, long* builds, bool direct = false) {
   const DemMaterial m = demtest::material(1e-3, 0.9, 0.75, 0.5, 0.24, 0.06, 0.05, 5e6, 1040.0);
   DemSettings s;
   s.time_step = 0.2 * m.rayleighTime();
@@ -179,6 +179,7 @@ std::vector<Eigen::Vector3d> bedById(int sort_interval, long* builds) {
   s.rolling_model = "cdt";
   s.skin_fraction = 0.02;
   s.sort_interval = sort_interval;
+  s.serial_direct_accumulation = direct;
   DemSystem dem(m, DemWalls::box(Eigen::Vector3d(-0.01, 0, 0), Eigen::Vector3d(0.01, 0.05, 0.02)), s);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -209,6 +210,22 @@ TEST(NeighbourList, SpatialSortingKeepsTheDynamics) {
   // particles by micrometres.
   EXPECT_LT(worst, 1e-10) << "largest position difference [m]";
   RecordProperty("max_position_difference_m", ::testing::PrintToString(worst));
+}
+
+TEST(NeighbourList, SerialReferenceSchemeAgreesWithTheGather) {
+  // The benchmark's reference (forces added straight into the particles, one thread) must be the
+  // same physics as the deterministic per-pair gather, up to the order of the sums.
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(1);
+  long b1 = 0, b2 = 0;
+  const auto gather = bedById(10, &b1, false);
+  const auto direct = bedById(10, &b2, true);
+  omp_set_num_threads(before);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < gather.size(); ++i) worst = std::max(worst, (gather[i] - direct[i]).norm());
+  EXPECT_LT(worst, 1e-10);
+  EXPECT_GT(worst, 0.0) << "the sums run in another order, so the last bits differ: if not, the "
+                           "reference scheme was not used";
 }
 
 }  // namespace
