@@ -6,6 +6,7 @@
 /// separate model (scene effect `rolling_friction`) that a contact model applies when given one.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,10 +32,16 @@ struct WallHistory {
 
 /// Per-pair results of the particle-particle pass (indexed like the neighbour list's pairs).
 struct PairForces {
+  std::vector<std::uint8_t> active;       ///< 1 if the pair touches (only then are the rest set)
   std::vector<Eigen::Vector3d> force;     ///< force on i (on j: the opposite) [N]
   std::vector<Eigen::Vector3d> torque_i;  ///< [N m]
   std::vector<Eigen::Vector3d> torque_j;  ///< [N m]
-  void resize(std::size_t n) { force.resize(n); torque_i.resize(n); torque_j.resize(n); }
+  void resize(std::size_t n) {
+    active.resize(n);
+    force.resize(n);
+    torque_i.resize(n);
+    torque_j.resize(n);
+  }
 };
 
 /// Everything a contact model reads and writes in one force evaluation.
@@ -67,7 +74,7 @@ class ContactModel {
   virtual std::string name() const = 0;
   /// Uses `rolling` (may be null: no rolling resistance). Refuses a law it does not implement.
   virtual void setRollingModel(const RollingModel* rolling) = 0;
-  /// Particle-particle contacts: writes ctx.pair_forces for every listed pair (zero when apart) and
+  /// Particle-particle contacts: writes ctx.pair_forces for every listed pair (active = 0 when apart) and
   /// updates the pairs' tangential history. Does not touch the particles' accumulators.
   virtual void computePairs(ContactContext& ctx) const = 0;
   /// Particle-wall contacts of particle i: adds to `force` and `torque`, updates i's wall history;

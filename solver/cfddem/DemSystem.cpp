@@ -143,11 +143,13 @@ void DemSystem::computeForces(bool final_kick, int moved) {
     Vector3d t = Vector3d::Zero();
     if (gather_pairs) {
       for (auto q = list_.row_start[i]; q < list_.row_start[i + 1]; ++q) {
+        if (!pair_forces_.active[q]) continue;
         f += pair_forces_.force[q];
         t += pair_forces_.torque_i[q];
       }
       for (auto c = list_.col_start[i]; c < list_.col_start[i + 1]; ++c) {
         const auto q = list_.col_pair[c];
+        if (!pair_forces_.active[q]) continue;
         f -= pair_forces_.force[q];
         t += pair_forces_.torque_j[q];
       }

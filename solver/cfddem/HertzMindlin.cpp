@@ -60,10 +60,7 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
       const double r2 = d.squaredNorm();
       if (r2 >= rsum * rsum) {
         list.shear[q].setZero();
-        if constexpr (Direct) continue;
-        out.force[q].setZero();
-        out.torque_i[q].setZero();
-        out.torque_j[q].setZero();
+        if constexpr (!Direct) out.active[q] = 0;
         continue;
       }
       const double r = std::sqrt(r2);
@@ -82,6 +79,7 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
         p.torque[i] += -ri * c.n_x_ft + c.roll;
         p.torque[k] += -rk * c.n_x_ft - c.roll;
       } else {
+        out.active[q] = 1;
         out.force[q] = c.force;
         out.torque_i[q] = -ri * c.n_x_ft + c.roll;
         out.torque_j[q] = -rk * c.n_x_ft - c.roll;
