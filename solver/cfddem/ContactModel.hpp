@@ -30,16 +30,15 @@ struct WallHistory {
   }
 };
 
-/// Per-pair results of the particle-particle pass (indexed like the neighbour list's pairs).
+/// Per-pair results of the particle-particle pass for the pair's second member j (indexed like
+/// the neighbour list's pairs). The first member's share is summed in the pair loop itself.
 struct PairForces {
   std::vector<std::uint8_t> active;       ///< 1 if the pair touches (only then are the rest set)
   std::vector<Eigen::Vector3d> force;     ///< force on i (on j: the opposite) [N]
-  std::vector<Eigen::Vector3d> torque_i;  ///< [N m]
-  std::vector<Eigen::Vector3d> torque_j;  ///< [N m]
+  std::vector<Eigen::Vector3d> torque_j;  ///< torque on j [N m]
   void resize(std::size_t n) {
     active.resize(n);
     force.resize(n);
-    torque_i.resize(n);
     torque_j.resize(n);
   }
 };
@@ -74,8 +73,10 @@ class ContactModel {
   virtual std::string name() const = 0;
   /// Uses `rolling` (may be null: no rolling resistance). Refuses a law it does not implement.
   virtual void setRollingModel(const RollingModel* rolling) = 0;
-  /// Particle-particle contacts: writes ctx.pair_forces for every listed pair (active = 0 when apart) and
-  /// updates the pairs' tangential history. Does not touch the particles' accumulators.
+  /// Particle-particle contacts: sets particle i's accumulators to the sum over its own row (pairs
+  /// (i, j), in row order), writes the second members' shares into ctx.pair_forces (active = 0
+  /// when apart) and updates the tangential history. Gravity and the second members' shares are
+  /// added afterwards in a fixed order (DemSystem), so the result does not depend on threads.
   virtual void computePairs(ContactContext& ctx) const = 0;
   /// Particle-wall contacts of particle i: adds to `force` and `torque`, updates i's wall history;
   /// raises `max_overlap` (delta / r) and counts contacts. Called concurrently for different i.

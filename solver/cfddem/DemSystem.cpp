@@ -135,18 +135,14 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   const bool gather_pairs = !ctx.direct;
   double max_overlap = 0.0;
   long wall_contacts = 0;
-  // Gather in a fixed order (own pairs, then pairs as second member, then walls): independent of
-  // the thread count. The second half kick of velocity Verlet is fused into the same loop.
+  // Gather in a fixed order (gravity + own row, then pairs as second member, then walls):
+  // independent of the thread count. The second half kick of velocity Verlet is fused into the same loop.
 #pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : wall_contacts) if (n >= kDemParallelMinParticles)
   for (long i = 0; i < n; ++i) {
-    Vector3d f = p.mass[i] * g;
-    Vector3d t = Vector3d::Zero();
+    Vector3d f, t;
     if (gather_pairs) {
-      for (auto q = list_.row_start[i]; q < list_.row_start[i + 1]; ++q) {
-        if (!pair_forces_.active[q]) continue;
-        f += pair_forces_.force[q];
-        t += pair_forces_.torque_i[q];
-      }
+      f = p.mass[i] * g + p.force[i];  // own row, summed by the pair loop
+      t = p.torque[i];
       for (auto c = list_.col_start[i]; c < list_.col_start[i + 1]; ++c) {
         const auto q = list_.col_pair[c];
         if (!pair_forces_.active[q]) continue;

@@ -53,6 +53,7 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
   for (long i = 0; i < n; ++i) {
     const Vector3d xi = p.x[i], vi = p.v[i], wi = p.omega[i];
     const double ri = p.radius[i], mi = p.mass[i];
+    Vector3d fi = Vector3d::Zero(), ti = Vector3d::Zero();
     for (auto q = list.row_start[i]; q < list.row_start[i + 1]; ++q) {
       const auto k = list.j[q];
       const Vector3d d = xi - p.x[k];
@@ -79,13 +80,18 @@ void HertzMindlin::pairs(ContactContext& ctx) const {
         p.torque[i] += -ri * c.n_x_ft + c.roll;
         p.torque[k] += -rk * c.n_x_ft - c.roll;
       } else {
+        fi += c.force;
+        ti += -ri * c.n_x_ft + c.roll;
         out.active[q] = 1;
         out.force[q] = c.force;
-        out.torque_i[q] = -ri * c.n_x_ft + c.roll;
         out.torque_j[q] = -rk * c.n_x_ft - c.roll;
       }
       max_overlap = std::max(max_overlap, delta / std::min(ri, rk));
       ++contacts;
+    }
+    if constexpr (!Direct) {
+      p.force[i] = fi;
+      p.torque[i] = ti;
     }
   }
   ctx.max_overlap_fraction = std::max(ctx.max_overlap_fraction, max_overlap);
