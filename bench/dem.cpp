@@ -155,21 +155,10 @@ const bool registered = addBenchmark(
 // region 0.2 m < y < 0.3 m and settled; reports parcels outside the walls or inside the inlet.
 #include "cfddem/ApparatusWalls.hpp"
 #include "cfddem/DemFilling.hpp"
+#include "geometry/Apparatus.hpp"
 
 namespace rcfd::bench {
 namespace {
-
-/// The prismatic spouted bed's cross-section from its spec (the same polygon as Apparatus.cpp);
-/// to be replaced by wallsFromApparatus(Apparatus(spec)) once the geometry module is on main.
-std::vector<SectionEdge> prismaticSection(const ApparatusSpec& a) {
-  const double wi = 0.5 * a.inlet_width, w = 0.5 * a.width;
-  const double yv = (w - wi) * std::tan(a.prism_angle_deg * M_PI / 180.0);
-  const std::vector<Eigen::Vector2d> o = {{-wi, 0.0}, {wi, 0.0}, {w, yv}, {w, a.height},
-                                          {-w, a.height}, {-w, yv}};
-  std::vector<SectionEdge> e;
-  for (std::size_t i = 0; i < o.size(); ++i) e.push_back({o[i], o[(i + 1) % o.size()]});
-  return e;
-}
 
 nlohmann::json runProCell(const Options& opt) {
   spdlog::set_level(spdlog::level::info);
@@ -179,24 +168,20 @@ nlohmann::json runProCell(const Options& opt) {
   DemSettings s = DemSystem::settingsFromScene(scene);
   s.rolling_model = "cdt";
   s.time_step = 0.25 * m.rayleighTime();  // the paper's 1 us would take 50x longer to settle
-  const auto section = prismaticSection(scene.apparatus);
-  DemSystem dem(m, wallsFromSection(section, scene.apparatus.depth), s);
+  const Apparatus apparatus(scene.apparatus);
+  DemSystem dem(m, wallsFromApparatus(apparatus), s);
   const long n = parcelsForBedMass(scene);
   const auto t0 = std::chrono::steady_clock::now();
   FillOptions fo;
   fo.max_settle_time = 1.0;
   const FillResult r = fillAndSettle(dem, defaultFillRegion(scene.apparatus), n, fo);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // Independent check against the polygon: every centre at least one radius inside, none below y=0.
+  // Independent check with the apparatus's own signed distance (not the DEM wall primitives).
   long outside = 0, in_inlet = 0;
   double top = 0.0, mass = 0.0, min_clear = 1.0;
   for (std::size_t i = 0; i < dem.particles().size(); ++i) {
     const Vector3d& x = dem.particles().x[i];
-    double c = std::min(x.z(), scene.apparatus.depth - x.z());
-    for (const auto& e : section) {
-      const Eigen::Vector2d t = (e.b - e.a).normalized();
-      c = std::min(c, (Eigen::Vector2d(x.x(), x.y()) - e.a).dot(Eigen::Vector2d(-t.y(), t.x())));
-    }
+    const double c = apparatus.signedDistance(x);
     min_clear = std::min(min_clear, c / m.particle_radius);
     if (c < 0.0) ++outside;
     if (x.y() < 0.0) ++in_inlet;
