@@ -1,0 +1,138 @@
+#include "cfddem/DemFilling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <spdlog/spdlog.h>
+#include <unordered_map>
+
+#include "core/Errors.hpp"
+
+namespace rcfd {
+
+using Eigen::Vector3d;
+
+long parcelsForBedMass(const Scene& scene) {
+  const double d = scene.particles.diameter;
+  const double m_particle = std::numbers::pi / 6.0 * d * d * d * scene.particles.density;
+  const double cg = scene.dem.coarse_graining;
+  return std::lround(scene.process.bed_mass / (cg * cg * cg * m_particle));
+}
+
+FillRegion defaultFillRegion(const ApparatusSpec& a) {
+  FillRegion r;
+  if (a.type == ApparatusSpec::Type::Box) {
+    r.lower = Vector3d(-0.5 * a.size.x(), 2.0 / 3.0 * a.size.y(), 0.0);
+    r.upper = Vector3d(0.5 * a.size.x(), a.size.y(), a.size.z());
+  } else {
+    r.lower = Vector3d(-0.5 * a.width, 0.2, 0.0);
+    r.upper = Vector3d(0.5 * a.width, std::min(0.3, a.height), a.depth);
+  }
+  return r;
+}
+
+double settle(DemSystem& dem, double max_time, double fraction, bool* settled) {
+  const DemParticles& p = dem.particles();
+  const double g = dem.settings().gravity.norm();
+  const double t0 = dem.time();
+  const long check = std::max(1L, static_cast<long>(1e-3 / dem.timeStep()));  // every 1 ms
+  bool ok = false;
+  while (dem.time() - t0 < max_time) {
+    dem.run(check);
+    double ref = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) ref += p.mass[i] * g * p.radius[i];
+    if (p.size() == 0 || p.kineticEnergy() < fraction * ref) {
+      ok = true;
+      break;
+    }
+  }
+  if (settled) *settled = ok;
+  return dem.time() - t0;
+}
+
+namespace {
+
+/// Hash of occupied cells of edge 2 r for the overlap test of new parcels.
+struct Occupancy {
+  double cell;
+  std::unordered_map<long long, std::vector<Vector3d>> cells;
+  long long key(long i, long j, long k) const {
+    return (i + (1LL << 20)) * (1LL << 42) + (j + (1LL << 20)) * (1LL << 21) + (k + (1LL << 20));
+  }
+  void add(const Vector3d& x) {
+    cells[key(std::lround(std::floor(x.x() / cell)), std::lround(std::floor(x.y() / cell)),
+               std::lround(std::floor(x.z() / cell)))].push_back(x);
+  }
+  bool free(const Vector3d& x, double min_dist) const {
+    const long ci = std::lround(std::floor(x.x() / cell)), cj = std::lround(std::floor(x.y() / cell)),
+               ck = std::lround(std::floor(x.z() / cell));
+    for (long i = ci - 1; i <= ci + 1; ++i)
+      for (long j = cj - 1; j <= cj + 1; ++j)
+        for (long k = ck - 1; k <= ck + 1; ++k) {
+          auto it = cells.find(key(i, j, k));
+          if (it == cells.end()) continue;
+          for (const Vector3d& y : it->second)
+            if ((x - y).squaredNorm() < min_dist * min_dist) return false;
+        }
+    return true;
+  }
+};
+
+}  // namespace
+
+FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, const FillOptions& o) {
+  FillResult result;
+  const double r = dem.material().particle_radius;
+  const double g = dem.settings().gravity.norm();
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Vector3d lo = region.lower + Vector3d::Constant(r), hi = region.upper - Vector3d::Constant(r);
+  if ((hi.array() <= lo.array()).any())
+    throw RunError("DEM filling: the insertion region is smaller than a parcel");
+  // A batch falls clear of the region in about sqrt(2 h / g) (plus one diameter).
+  const double height = region.upper.y() - region.lower.y();
+  const double fall_time = g > 0.0 ? std::sqrt(2.0 * (height + 2.0 * r) / g) : 0.0;
+  const double t0 = dem.time();
+  const double gap = 1.02 * 2.0 * r;  // parcels start just clear of each other
+  while (result.inserted < count) {
+    if (result.batches >= o.max_batches)
+      throw RunError("DEM filling: " + std::to_string(count - result.inserted) + " of " +
+                     std::to_string(count) + " parcels found no room after " +
+                     std::to_string(o.max_batches) + " batches; enlarge the insertion region");
+    ++result.batches;
+    Occupancy occ{2.0 * r, {}};
+    const DemParticles& p = dem.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if ((p.x[i].array() > region.lower.array() - 2 * r).all() &&
+          (p.x[i].array() < region.upper.array() + 2 * r).all())
+        occ.add(p.x[i]);
+    long misses = 0, batch = 0;
+    const long max_misses = 2000 + 20 * (count - result.inserted);
+    while (result.inserted < count && misses < max_misses) {
+      const Vector3d x = lo + (hi - lo).cwiseProduct(Vector3d(u(rng), u(rng), u(rng)));
+      if (dem.walls().clearance(x) < 1.01 * r || !occ.free(x, gap)) {
+        ++misses;
+        continue;
+      }
+      occ.add(x);
+      dem.addParticle(x);
+      ++result.inserted;
+      ++batch;
+    }
+    spdlog::debug("DEM filling: batch {} inserted {} parcels ({} of {})", result.batches, batch,
+                  result.inserted, count);
+    if (batch == 0 && g == 0.0) throw RunError("DEM filling: no room and no gravity to make room");
+    // Let the batch fall clear (after the last one too, so settling starts with the bed in motion).
+    dem.run(std::max(1L, std::lround(fall_time / dem.timeStep())));
+  }
+  result.fill_time = dem.time() - t0;
+  result.settle_time = settle(dem, o.max_settle_time, o.settled_energy_fraction, &result.settled);
+  result.kinetic_energy = dem.particles().kineticEnergy();
+  spdlog::info("DEM filling: {} parcels in {} batches, {:.3f} s falling + {:.3f} s settling, {}",
+               result.inserted, result.batches, result.fill_time, result.settle_time,
+               result.settled ? "settled" : "not settled (time limit)");
+  return result;
+}
+
+}  // namespace rcfd

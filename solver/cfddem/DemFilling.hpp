@@ -1,0 +1,54 @@
+#pragma once
+/// \file DemFilling.hpp
+/// Filling the apparatus: insert the bed mass as parcels at random non-overlapping positions in a
+/// region above the bed (batch after batch, each batch falling clear before the next), then let the
+/// bed settle under gravity (DEM only) until its kinetic energy is small. A DEM-only database job
+/// (the scene's effects without `gas`) runs this and starts the gas run from the settled state.
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "cfddem/DemSystem.hpp"
+#include "scene/Scene.hpp"
+
+namespace rcfd {
+
+struct FillRegion {
+  Eigen::Vector3d lower = Eigen::Vector3d::Zero();  ///< [m]
+  Eigen::Vector3d upper = Eigen::Vector3d::Zero();  ///< [m]
+};
+
+struct FillOptions {
+  std::uint64_t seed = 1;          ///< random positions (deterministic for a seed)
+  double max_settle_time = 0.5;    ///< settling stops after this time at the latest [s]
+  /// Settled when the kinetic energy per parcel is below this fraction of m g r (mean speed about
+  /// sqrt(2 fraction g r)) [-].
+  double settled_energy_fraction = 1e-3;
+  int max_batches = 200;           ///< refuse to go on when the region never takes all parcels
+};
+
+struct FillResult {
+  long inserted = 0;          ///< parcels inserted
+  int batches = 0;
+  double fill_time = 0.0;     ///< simulated time spent inserting [s]
+  double settle_time = 0.0;   ///< simulated time spent settling [s]
+  double kinetic_energy = 0.0;  ///< at the end [J]
+  bool settled = false;       ///< the energy criterion was met (else max_settle_time ran out)
+};
+
+/// Number of parcels of the scene's bed: M_P / (cg^3 m_P), rounded to the nearest integer.
+long parcelsForBedMass(const Scene& scene);
+
+/// The paper's insertion region for the prismatic spouted bed, 0.2 m < y < 0.3 m over the chamber's
+/// width and depth; for a box, the upper third.
+FillRegion defaultFillRegion(const ApparatusSpec& apparatus);
+
+/// Inserts `count` parcels in `region` (clear of walls and of each other), lets them fall and settles.
+/// Throws rcfd::RunError when the region cannot take the parcels within max_batches.
+FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count,
+                         const FillOptions& options = {});
+
+/// Runs until the kinetic energy criterion holds or max_time passes; returns the time run [s].
+double settle(DemSystem& dem, double max_time, double settled_energy_fraction, bool* settled = nullptr);
+
+}  // namespace rcfd
