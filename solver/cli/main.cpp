@@ -1,6 +1,9 @@
 // rcfd-solve: the solver's command line (CONTRACTS.md). Every sub-command lives in its own file and
 // registers itself through cli::addCommand; this file only parses and maps failures to exit codes.
 
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
 #include <iostream>
 #include <map>
 #include <memory>
@@ -28,6 +31,8 @@ bool addCommand(std::string name, std::string description, Setup setup) {
 
 int main(int argc, char** argv) {
   using namespace rcfd;
+  // stdout carries only machine-readable output (--progress-json lines, --json reports): logs go to stderr.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("rcfd"));
   CLI::App app{"rcfd-solve: recurrence CFD of spray coating in spouted beds"};
   app.require_subcommand(1);
   std::map<CLI::App*, cli::Action> actions;

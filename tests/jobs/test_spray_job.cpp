@@ -1,0 +1,164 @@
+// The spray job through the real rcfd-solve binary: a database file, a job file, progress lines,
+// SIGTERM-style interruption (exit 130 with a checkpoint) and resume equal to an uninterrupted run.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include "core/Hdf5.hpp"
+#include "fields/AnalyticDatabase.hpp"
+#include "geometry/Apparatus.hpp"
+#include "scene/SceneLoader.hpp"
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kSolver = std::string(RCFD_BINARY_DIR) + "/rcfd-solve";
+
+json sceneDocument() {
+  return json::parse(R"({
+    "name": "spray-job-test",
+    "apparatus": {"type": "box", "size": [0.1, 0.15, 0.04], "outlet_top": true},
+    "grid": {"cell_size": 0.01},
+    "gas": {}, "particles": {},
+    "process": {"bed_mass": 0.3},
+    "rcfd": {"dt": 0.005, "tracers": 5000, "d0": 5e-4, "path": {"type": "paper"}},
+    "spray": {"nozzle_position": [0.0, 0.005, 0.02], "nozzle_diameter": 0.002, "parcels_per_s": 4000,
+              "spray_zone": {"apex": [0.0, 0.005, 0.02], "y_min": 0.01, "y_max": 0.08}},
+    "probes": [{"name": "centre", "position": [0.0, 0.05, 0.02]}],
+    "effects": ["transport", "walls", "fluctuation", "free_flight", "tracer_volume_fraction", "probes",
+                "residence_time", "spray", "deposition", "coverage", "deposition_maps"]
+  })");
+}
+
+struct SolveResult {
+  int exitCode = -1;
+  std::string out;
+};
+
+SolveResult solve(const std::string& args) {
+  SolveResult r;
+  FILE* pipe = popen((kSolver + " " + args + " 2>/dev/null").c_str(), "r");
+  if (!pipe) return r;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) r.out += buffer;
+  const int status = pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class SprayJob : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(testing::TempDir()) / ("spray-job-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    const json scene = sceneDocument();
+    const rcfd::Scene s = rcfd::loadScene(scene);
+    rcfd::Apparatus box(s.apparatus);
+    const auto grid = rcfd::makeGrid(box, s.grid);
+    const auto open = rcfd::openFractions(box, grid);
+    const std::vector<float> fluid(open.begin(), open.end());
+    rcfd::writeAnalyticDatabase((dir_ / "db.h5").string(), grid, fluid, 0.005, 40,
+                                [grid](int n, double t, rcfd::FieldFrame& f) {
+                                  for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+                                    const auto ijk = grid.cellIjk(c);
+                                    const auto p = grid.cellCenter(ijk[0], ijk[1], ijk[2]);
+                                    const double phase = 2 * 3.14159265358979 * t / 0.1;  // period 20 frames
+                                    const bool spout = std::abs(p.x() - 0.01 * std::sin(phase)) < 0.02;
+                                    f.alpha_p[std::size_t(c)] = float(p.y() < 0.07 ? (spout ? 0.15 : 0.5) : 0.0);
+                                    f.u_p[3 * c + 1] = float(spout ? 1.0 : -0.2);
+                                    f.u_g[3 * c + 1] = float(spout ? 6.0 : 1.0);
+                                    f.u_g[3 * c] = float(0.5 * std::sin(phase + 40 * p.y()) + 0.01 * n);
+                                  }
+                                },
+                                scene.dump());
+    const json job = {{"kind", "spray"}, {"scene", scene}, {"database", (dir_ / "db.h5").string()},
+                      {"duration", 0.4}, {"seed", 17}, {"checkpoint_interval", 0.1}};
+    std::ofstream(dir_ / "job.json") << job.dump(2);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static json summaryOf(const fs::path& out) {
+    json s = json::parse(std::ifstream(out / "summary.json"));
+    s.erase("wall_time_s");
+    s.erase("tracer_steps_per_s");
+    return s;
+  }
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(SprayJob, RunsAndReportsProgressAndTheContractKeys) {
+  const SolveResult r = solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "a").string() + " --progress-json");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  // Progress lines: one JSON object each, fraction rising to 1.
+  std::istringstream lines(r.out);
+  std::string line;
+  double last = -1.0;
+  int count = 0;
+  while (std::getline(lines, line)) {
+    const json p = json::parse(line);
+    ASSERT_TRUE(p.contains("fraction") && p.contains("sim_time") && p.contains("wall_time") && p.contains("eta_s"));
+    EXPECT_GE(p["fraction"].get<double>(), last);
+    last = p["fraction"].get<double>();
+    ++count;
+  }
+  EXPECT_GE(count, 1);
+  EXPECT_EQ(last, 1.0);
+  const json s = json::parse(std::ifstream(dir_ / "a" / "summary.json"));
+  for (const char* key : {"kind", "status", "seed", "wall_time_s", "steps", "sim_time_s", "effects", "tracers",
+                          "tracer_steps_per_s", "mass_balance", "overspray_fraction", "coverage",
+                          "droplets_per_tracer_mean", "residence_time", "holdup"}) {
+    EXPECT_TRUE(s.contains(key)) << key;
+  }
+  EXPECT_EQ(s["steps"].get<int>(), 80);
+  EXPECT_EQ(s["status"], "succeeded");
+  const auto& m = s["mass_balance"];
+  EXPECT_LE(std::abs(m["closure_error_kg"].get<double>()), 1e-9 * m["injected_kg"].get<double>());
+  EXPECT_TRUE(fs::exists(dir_ / "a" / "result.h5"));
+  EXPECT_TRUE(fs::exists(dir_ / "a" / "coverage.svg"));
+  EXPECT_TRUE(fs::exists(dir_ / "a" / "deposition_z.svg"));
+  EXPECT_FALSE(fs::exists(dir_ / "a" / "checkpoint.h5"));
+}
+
+TEST_F(SprayJob, InterruptedAndResumedEqualsUninterrupted) {
+  ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "a").string()).exitCode, 0);
+  const SolveResult stopped =
+      solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "b").string() + " --stop-after-steps 33");
+  EXPECT_EQ(stopped.exitCode, 130);
+  ASSERT_TRUE(fs::exists(dir_ / "b" / "checkpoint.h5"));
+  EXPECT_FALSE(fs::exists(dir_ / "b" / "summary.json"));
+  ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "b").string()).exitCode, 0);
+  EXPECT_EQ(summaryOf(dir_ / "a").dump(), summaryOf(dir_ / "b").dump());
+  rcfd::h5::File a((dir_ / "a" / "result.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+  rcfd::h5::File b((dir_ / "b" / "result.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+  for (const char* set : {"/tracers/x", "/tracers/y", "/coverage/droplets_per_particle", "/holdup/particles",
+                          "/deposition_maps/rate_density"}) {
+    EXPECT_EQ(a.readDoubles(set), b.readDoubles(set)) << set;
+  }
+}
+
+TEST_F(SprayJob, BadInputsExitTwoNamingTheField) {
+  json job = json::parse(std::ifstream(dir_ / "job.json"));
+  job["scene"]["rcfd"]["dt"] = 0.003;  // does not divide dt_rec = 0.005
+  std::ofstream(dir_ / "bad.json") << job.dump();
+  FILE* pipe = popen((kSolver + " run " + (dir_ / "bad.json").string() + " --out " + (dir_ / "c").string() +
+                      " 2>&1").c_str(), "r");
+  std::string text;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) text += buffer;
+  const int status = pclose(pipe);
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(text.find("/rcfd/dt"), std::string::npos) << text;
+  job = json::parse(std::ifstream(dir_ / "job.json"));
+  job["database"] = (dir_ / "missing.h5").string();
+  std::ofstream(dir_ / "bad2.json") << job.dump();
+  EXPECT_NE(solve("run " + (dir_ / "bad2.json").string() + " --out " + (dir_ / "d").string()).exitCode, 0);
+}
