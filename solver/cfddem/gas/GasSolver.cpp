@@ -22,6 +22,8 @@ inline double limitedSlope(double forward, double backward) {
 constexpr double kViscousSafety = 0.9;
 /// Safety factor on the explicit nozzle-source bound dt <= alpha / s.
 constexpr double kSourceSafety = 0.5;
+/// Face loops below this size run serially (fork/join and barrier costs dominate).
+constexpr std::size_t kParallelFaces = 100000;
 
 std::string cellText(const CartesianGrid& g, std::size_t c) {
   const auto ijk = g.cellIjk(std::int64_t(c));
@@ -300,7 +302,8 @@ void GasSolver::explicitRates(const std::array<std::vector<double>, 3>& u,
     const auto& kinds = kind_[std::size_t(d)];
     auto& out = rate[std::size_t(d)];
     const std::array<std::size_t, 3> stride{1, std::size_t(s[0]), std::size_t(s[0]) * s[1]};
-#pragma omp parallel for schedule(static)
+    const bool parallel = ud.size() > kParallelFaces;
+#pragma omp parallel for collapse(2) schedule(static) if (parallel)
     for (int k = 0; k < s[2]; ++k)
       for (int j = 0; j < s[1]; ++j)
         for (int i = 0; i < s[0]; ++i) {
@@ -427,7 +430,6 @@ double GasSolver::step(double maxDt) {
   time_ += dt;
   lastDt_ = dt;
   last_.dt = dt;
-  last_.divergence = divergence(dt);
   double rateMax = 0.0;
   for (int d = 0; d < 3; ++d) {
     double m = 0.0;

@@ -126,6 +126,7 @@ class GasSolver {
   double ghostValue(const std::vector<double>& u, int d, int e, std::array<int, 3> idx) const;
   double faceAlpha(int d, std::size_t f, int i, int j, int k) const;
   void project(double dt, const std::array<std::vector<double>, 3>& diag);
+  void correct(const std::array<std::vector<double>, 3>& diag);
   DivergenceResidual divergence(double dt) const;
   void checkAlpha(const std::vector<double>& alpha, const char* what) const;
 

@@ -46,13 +46,17 @@ void PressureSolver::applyPreconditioner(const Eigen::VectorXd& r, Eigen::Vector
 
 namespace {
 
+/// Below this many rows the OpenMP fork/join costs more than the loop (and, on a loaded machine, a
+/// descheduled thread stalls every barrier of every CG iteration).
+constexpr long kParallelRows = 150000;
+
 /// y = A x with the rows split over the OpenMP threads (Eigen runs sparse products serially).
 void multiply(const PressureSolver::Matrix& a, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   const int n = int(a.rows());
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-#pragma omp parallel for schedule(static) if (n > 20000)
+#pragma omp parallel for schedule(static) if (n > kParallelRows)
   for (int r = 0; r < n; ++r) {
     double s = 0.0;
     for (int q = outer[r]; q < outer[r + 1]; ++q) s += val[q] * x[inner[q]];
@@ -63,7 +67,7 @@ void multiply(const PressureSolver::Matrix& a, const Eigen::VectorXd& x, Eigen::
 double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const long n = a.size();
   double s = 0.0;
-#pragma omp parallel for reduction(+ : s) schedule(static) if (n > 20000)
+#pragma omp parallel for reduction(+ : s) schedule(static) if (n > kParallelRows)
   for (long i = 0; i < n; ++i) s += a[i] * b[i];
   return s;
 }
