@@ -38,6 +38,9 @@ TEST(GasVerification, PlanePoiseuilleProfileWithinOnePercent) {
     const double got = v[std::size_t(j) * shape[0] + i];
     maxErr = std::max(maxErr, std::abs(got - exact));
   }
+  RecordProperty("max_error_over_peak", std::to_string(maxErr / (1.5 * U)));
+  RecordProperty("dpdy_over_exact", std::to_string(g.pressureGradientAt(Eigen::Vector3d(0.0, 0.025, 0.5 * depth)).y() /
+                                                   (-12 * s.gas.density * s.gas.kinematic_viscosity * U / (H * H))));
   EXPECT_LT(maxErr, 0.01 * 1.5 * U) << "largest deviation from the parabola " << maxErr << " m/s";
   // Fully developed: the pressure gradient is the Poiseuille one, dp/dy = -12 mu U / H^2.
   const double mu = s.gas.density * s.gas.kinematic_viscosity;
@@ -97,6 +100,7 @@ TEST(GasVerification, PackedBedPressureDropMatchesErgun) {
     g.step(1.0);
   }
   const double ergun = (A * U + B * U * U) * (y1 - y0);
+  RecordProperty("pressure_drop_over_ergun", std::to_string(g.pressureDrop() / ergun));
   EXPECT_NEAR(g.pressureDrop(), ergun, 0.1 * ergun) << "Ergun " << ergun << " Pa";
   EXPECT_NEAR(-g.pressureGradientAt(Eigen::Vector3d(0.0, 0.075, 0.005)).y(), ergun / (y1 - y0),
               0.1 * ergun / (y1 - y0));

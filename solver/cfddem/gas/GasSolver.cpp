@@ -405,11 +405,16 @@ double GasSolver::step(double maxDt) {
           lo[std::size_t(d)] -= 1;
           const std::size_t cl = std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]));
           const std::size_t ch = std::size_t(grid_.flatIndex(i, j, k));
-          const double bF = 0.5 * (beta_[cl] + beta_[ch]);
-          if (bF > 0) {
-            const double up = (beta_[cl] * uParticle_[cl][d] + beta_[ch] * uParticle_[ch][d]) / (2 * bF);
-            const double kF = bF / (0.5 * (alphaNext_[cl] + alphaNext_[ch]) * rho);
-            v = (v + dt * kF * up) / (1 + dt * kF);
+          if (beta_[cl] > 0 || beta_[ch] > 0) {
+            // The face carries the mean of its two cells' f / (alpha rho) with the cell velocities
+            // u_c = alpha_f u_f / alpha_c (same flux), so the pressure difference across a bed is the
+            // sum of its cells' drag even where alpha_G jumps.
+            const double aF = 0.5 * (alphaNext_[cl] + alphaNext_[ch]);
+            const double kF = 0.5 * aF * (beta_[cl] / (alphaNext_[cl] * alphaNext_[cl]) +
+                                          beta_[ch] / (alphaNext_[ch] * alphaNext_[ch])) / rho;
+            const double target = 0.5 * (beta_[cl] * uParticle_[cl][d] / alphaNext_[cl] +
+                                         beta_[ch] * uParticle_[ch][d] / alphaNext_[ch]) / rho;
+            v = (v + dt * target) / (1 + dt * kF);
             diag[std::size_t(d)][f] = 1 / (1 + dt * kF);
           }
           ud[f] = v;
