@@ -32,8 +32,10 @@ TEST(GasProCell, InletAndNozzleCarryTheSceneFlows) {
   EXPECT_NEAR(gas::openSegmentLength(withPlates, {0.0, 0.09}, {0.05, 0.09}), 0.05 - 0.002, 1e-14);
 }
 
-void expectMassConserved(bool plates) {
-  GasCase c(quickSliceScene(plates));
+void expectMassConserved(bool plates, const std::string& preconditioner = "ic") {
+  gas::GasOptions o;
+  o.preconditioner = preconditioner;
+  GasCase c(quickSliceScene(plates), o);
   auto& g = *c.solver;
   const double q = c.scene.process.gas_flow_rate + c.scene.process.atomisation_flow_rate;
   for (int n = 0; n < 15; ++n) {
@@ -53,6 +55,10 @@ void expectMassConserved(bool plates) {
 
 TEST(GasProCell, MassConservedWithoutPlates) { expectMassConserved(false); }
 TEST(GasProCell, MassConservedWithPlates) { expectMassConserved(true); }
+TEST(GasProCell, MassConservedWithMultigridAndJacobi) {
+  expectMassConserved(true, "mg");
+  expectMassConserved(false, "jacobi");
+}
 
 // A bubble of low alpha_G rising and breathing through the bed region: every step, the discrete
 // Eq. (1) residual is below the pressure tolerance, and the global balance includes the storage term.

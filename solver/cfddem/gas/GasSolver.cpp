@@ -113,6 +113,11 @@ void GasSolver::buildTopology() {
   for (std::size_t c = 0; c < cells; ++c)
     if (active_[c]) unknown_[c] = count++;
   q_ = Eigen::VectorXd::Zero(count);
+  std::vector<std::array<int, 3>> cellOf;
+  cellOf.reserve(std::size_t(count));
+  for (std::size_t c = 0; c < cells; ++c)
+    if (active_[c]) cellOf.push_back(grid_.cellIjk(std::int64_t(c)));
+  pressureSolver_->setCells(std::move(cellOf));
 
   // Face kinds. Grid-boundary faces are open only at y = 0 (inlet) and at the top (outlet).
   double inletArea = 0.0;

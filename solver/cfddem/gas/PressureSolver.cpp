@@ -11,7 +11,8 @@ namespace rcfd::gas {
 Preconditioner parsePreconditioner(const std::string& name) {
   if (name == "ic") return Preconditioner::IncompleteCholesky;
   if (name == "jacobi") return Preconditioner::Jacobi;
-  throw std::invalid_argument("unknown pressure preconditioner \"" + name + "\"; valid names are: ic jacobi");
+  if (name == "mg") return Preconditioner::Multigrid;
+  throw std::invalid_argument("unknown pressure preconditioner \"" + name + "\"; valid names are: ic jacobi mg");
 }
 
 struct PressureSolver::IcHolder {
@@ -25,10 +26,24 @@ PressureSolver::PressureSolver(Preconditioner kind, int refactorInterval)
 
 PressureSolver::~PressureSolver() = default;
 
+void PressureSolver::setCells(std::vector<std::array<int, 3>> cellOf) {
+  cells_ = std::move(cellOf);
+  mg_.reset();
+}
+
 void PressureSolver::setMatrix(const Matrix& a, bool force) {
   const bool newPattern = a.rows() != a_.rows() || a.nonZeros() != a_.nonZeros();
   a_ = a;
   inverseDiagonal_ = a_.diagonal().cwiseInverse();
+  if (kind_ == Preconditioner::Multigrid) {
+    if (!mg_ || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
+      if (cells_.size() != std::size_t(a_.rows())) throw std::logic_error("multigrid: setCells() not called");
+      if (!mg_) mg_ = std::make_unique<AggregationMultigrid>(cells_);
+      mg_->compute(a_);
+      sinceFactor_ = 0;
+    }
+    return;
+  }
   if (kind_ != Preconditioner::IncompleteCholesky) return;
   if (!ic_ || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
     if (!ic_) ic_ = std::make_unique<IcHolder>();
@@ -41,6 +56,7 @@ void PressureSolver::setMatrix(const Matrix& a, bool force) {
 
 void PressureSolver::applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
   if (kind_ == Preconditioner::IncompleteCholesky) z = ic_->factor.solve(r);
+  else if (kind_ == Preconditioner::Multigrid) mg_->apply(r, z);
   else z = inverseDiagonal_.cwiseProduct(r);
 }
 

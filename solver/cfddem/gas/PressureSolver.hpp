@@ -9,13 +9,17 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <memory>
+#include <array>
 #include <string>
+#include <vector>
+
+#include "cfddem/gas/AggregationMultigrid.hpp"
 
 namespace rcfd::gas {
 
-enum class Preconditioner { IncompleteCholesky, Jacobi };
+enum class Preconditioner { IncompleteCholesky, Jacobi, Multigrid };
 
-/// Parses "ic" or "jacobi"; throws std::invalid_argument otherwise.
+/// Parses "ic", "jacobi" or "mg"; throws std::invalid_argument otherwise.
 Preconditioner parsePreconditioner(const std::string& name);
 
 struct PressureSolveStats {
@@ -40,6 +44,9 @@ class PressureSolver {
 
   const Matrix& matrix() const { return a_; }
 
+  /// The grid cell (i, j, k) of every unknown: the multigrid's aggregates. Call before setMatrix().
+  void setCells(std::vector<std::array<int, 3>> cellOf);
+
  private:
   void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
 
@@ -50,6 +57,8 @@ class PressureSolver {
   Eigen::VectorXd inverseDiagonal_;
   struct IcHolder;
   std::unique_ptr<IcHolder> ic_;
+  std::vector<std::array<int, 3>> cells_;
+  std::unique_ptr<AggregationMultigrid> mg_;
 };
 
 }  // namespace rcfd::gas
