@@ -28,8 +28,8 @@ namespace rcfd::gas {
 
 /// Settings that are not in the scene (solver choices and verification set-ups).
 struct GasOptions {
-  std::string preconditioner = "ic";  ///< "ic" (incomplete Cholesky), "jacobi" or "mg" (multigrid)
-  int refactorInterval = 20;          ///< steps between IC refactorisations while the matrix drifts
+  std::string preconditioner = "mg";  ///< "mg" (aggregation multigrid), "ic" (incomplete Cholesky) or "jacobi"
+  int refactorInterval = 20;          ///< steps between preconditioner rebuilds (IC, mg) while the matrix drifts
   int maxPressureIterations = 2000;
   /// The front and back walls (z = 0, z = depth) without friction: plane flow in a slice. Default
   /// no-slip, as in the real apparatus.
