@@ -23,8 +23,11 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
   const double vol = grid_.cellVolume();
   const int unknowns = int(q_.size());
   Eigen::VectorXd b = Eigen::VectorXd::Zero(unknowns), scale = Eigen::VectorXd::Zero(unknowns);
+  // The matrix depends on alpha_G and on the drag factor D (with dt): rebuilt only when those may have
+  // changed.
+  const bool rebuild = matrixDirty_ || hasDrag_ || pressureSolver_->matrix().rows() != unknowns;
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(std::size_t(unknowns) * 7);
+  if (rebuild) triplets.reserve(std::size_t(unknowns) * 7);
   for (std::size_t c = 0; c < alpha_.size(); ++c) {
     const int r = unknown_[c];
     if (r < 0) continue;
@@ -48,6 +51,7 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
           const int rHi = i < n[0] && j < n[1] && k < n[2] ? unknown_[std::size_t(grid_.flatIndex(i, j, k))] : -1;
           if (rLo >= 0) b[rLo] -= flux, scale[rLo] += std::abs(flux);
           if (rHi >= 0) b[rHi] += flux, scale[rHi] += std::abs(flux);
+          if (!rebuild) continue;
           if (kind == Interior) {
             const double cf = aaa * diag[std::size_t(d)][f] / h[d];
             triplets.emplace_back(rLo, rLo, cf);
@@ -59,14 +63,17 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
           }
         }
   }
-  PressureSolver::Matrix m(unknowns, unknowns);
-  m.setFromTriplets(triplets.begin(), triplets.end());
-  // The matrix only changes with alpha_G or the drag; the preconditioner follows PressureSolver's rules.
-  const bool same = m.nonZeros() == pressureSolver_->matrix().nonZeros() &&
-                    m.rows() == pressureSolver_->matrix().rows() &&
-                    Eigen::Map<const Eigen::VectorXd>(m.valuePtr(), m.nonZeros()) ==
-                        Eigen::Map<const Eigen::VectorXd>(pressureSolver_->matrix().valuePtr(), m.nonZeros());
-  if (!same) pressureSolver_->setMatrix(m);
+  if (rebuild) {
+    PressureSolver::Matrix m(unknowns, unknowns);
+    m.setFromTriplets(triplets.begin(), triplets.end());
+    // Unchanged values (alpha_G set again to the same field) keep the preconditioner.
+    const bool same = m.nonZeros() == pressureSolver_->matrix().nonZeros() &&
+                      m.rows() == pressureSolver_->matrix().rows() &&
+                      Eigen::Map<const Eigen::VectorXd>(m.valuePtr(), m.nonZeros()) ==
+                          Eigen::Map<const Eigen::VectorXd>(pressureSolver_->matrix().valuePtr(), m.nonZeros());
+    if (!same) pressureSolver_->setMatrix(m);
+    matrixDirty_ = false;
+  }
   // Warm start from the last pressure, rescaled to this dt (q = p dt / rho).
   const double rho = scene_.gas.density;
   for (std::size_t c = 0; c < alpha_.size(); ++c)

@@ -205,6 +205,7 @@ void GasSolver::setGasFraction(const std::vector<double>& alphaG) {
   checkAlpha(alphaG, "alpha_G");
   alphaNext_ = alphaG;
   givenRate_ = false;
+  matrixDirty_ = true;
 }
 
 void GasSolver::setGasFraction(const std::vector<double>& alphaG, const std::vector<double>& dAlphaDt) {
@@ -216,6 +217,7 @@ void GasSolver::setGasFraction(const std::vector<double>& alphaG, const std::vec
   alphaNext_ = alphaG;
   dAlphaDt_ = dAlphaDt;
   givenRate_ = true;
+  matrixDirty_ = true;
 }
 
 void GasSolver::setDragSource(const std::vector<double>& beta, const std::vector<Eigen::Vector3d>& uP) {
@@ -227,6 +229,8 @@ void GasSolver::setDragSource(const std::vector<double>& beta, const std::vector
                      std::to_string(beta[c]) + " at " + cellText(grid_, c));
   beta_ = beta;
   uParticle_ = uP;
+  hasDrag_ = std::any_of(beta_.begin(), beta_.end(), [](double b) { return b > 0; });
+  matrixDirty_ = true;
 }
 
 void GasSolver::setExplicitSource(const std::vector<Eigen::Vector3d>& force) {

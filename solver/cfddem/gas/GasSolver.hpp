@@ -142,6 +142,8 @@ class GasSolver {
   std::vector<int> unknown_;      ///< pressure unknown per cell, -1 for inactive
   std::vector<double> alpha_, alphaNext_, dAlphaDt_;
   bool givenRate_ = false;
+  bool matrixDirty_ = true;  ///< alpha_G changed since the pressure matrix was built
+  bool hasDrag_ = false;     ///< some beta > 0: the matrix changes with dt
   std::vector<double> beta_;
   std::vector<Eigen::Vector3d> uParticle_, fExplicit_;
   std::vector<double> source_;    ///< nozzle volume source per unit volume s_c [1/s]
