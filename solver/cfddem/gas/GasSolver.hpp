@@ -10,7 +10,7 @@
 ///  - The drag source is a force per unit cell volume acting on the gas, f = -beta (u_G - u_P) + f_expl
 ///    [N/m3], i.e. the last term of Eq. (2) times rho_G: alpha_G sum_i F_i,drag / V. beta >= 0 [kg/(m3 s)]
 ///    is treated implicitly.
-///  - The pressure p is kinematic-free, in Pa, relative to the outlet (p = 0 at the top).
+///  - p is the pressure in Pa (not divided by rho_G), relative to the outlet (p = 0 at the top).
 
 #include <Eigen/Core>
 #include <array>
@@ -60,7 +60,8 @@ class GasSolver {
  public:
   /// Builds the grid topology (face apertures, active cells, inlet/outlet/nozzle faces). Throws
   /// InputError naming the scene field when the set-up cannot carry a flow (no outlet, a nozzle outside
-  /// the open region, an inlet flow with no inlet).
+  /// the open region, an inlet flow with no inlet). Keeps references to scene and apparatus: they must
+  /// outlive the solver.
   GasSolver(const Scene& scene, const Apparatus& apparatus, const CartesianGrid& grid,
             GasOptions options = {});
   ~GasSolver();
