@@ -1,0 +1,86 @@
+// Aggregation multigrid V-cycle for the pressure CG (AggregationMultigrid.hpp).
+
+#include "cfddem/gas/AggregationMultigrid.hpp"
+
+#include <map>
+#include <stdexcept>
+
+namespace rcfd::gas {
+namespace {
+
+/// Levels stop coarsening below this many unknowns: the coarsest is solved by sparse Cholesky.
+constexpr int kCoarsestUnknowns = 400;
+
+/// One symmetric-Gauss-Seidel half sweep on a row-major matrix (forward or backward).
+void gaussSeidel(const AggregationMultigrid::Matrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x, bool forward) {
+  const int n = int(a.rows());
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* val = a.valuePtr();
+  for (int s = 0; s < n; ++s) {
+    const int r = forward ? s : n - 1 - s;
+    double sum = b[r], diag = 0.0;
+    for (int q = outer[r]; q < outer[r + 1]; ++q) {
+      if (inner[q] == r) diag = val[q];
+      else sum -= val[q] * x[inner[q]];
+    }
+    x[r] = sum / diag;
+  }
+}
+
+}  // namespace
+
+AggregationMultigrid::AggregationMultigrid(std::vector<std::array<int, 3>> cellOf) : cellOf_(std::move(cellOf)) {}
+AggregationMultigrid::~AggregationMultigrid() = default;
+
+void AggregationMultigrid::compute(const Matrix& a) {
+  levels_.clear();
+  levels_.push_back({a, {}, 0});
+  std::vector<std::array<int, 3>> cells = cellOf_;
+  while (levels_.back().a.rows() > kCoarsestUnknowns) {
+    Level& fine = levels_.back();
+    // Aggregates: the 2x2x2 blocks of this level's cell coordinates.
+    std::map<std::array<int, 3>, int> index;
+    fine.coarseOf.resize(cells.size());
+    std::vector<std::array<int, 3>> coarseCells;
+    for (std::size_t r = 0; r < cells.size(); ++r) {
+      const std::array<int, 3> key{cells[r][0] / 2, cells[r][1] / 2, cells[r][2] / 2};
+      auto [it, inserted] = index.emplace(key, int(coarseCells.size()));
+      if (inserted) coarseCells.push_back(key);
+      fine.coarseOf[r] = it->second;
+    }
+    fine.coarseCount = int(coarseCells.size());
+    if (fine.coarseCount >= int(cells.size())) break;  // no coarsening left
+    Eigen::SparseMatrix<double> p(Eigen::Index(cells.size()), fine.coarseCount);
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(cells.size());
+    for (std::size_t r = 0; r < cells.size(); ++r) t.emplace_back(int(r), fine.coarseOf[r], 1.0);
+    p.setFromTriplets(t.begin(), t.end());
+    const Eigen::SparseMatrix<double> af = fine.a;
+    Eigen::SparseMatrix<double> ac = Eigen::SparseMatrix<double>(p.transpose()) * af * p;
+    levels_.push_back({Matrix(ac), {}, 0});
+    cells = std::move(coarseCells);
+  }
+  coarse_.compute(Eigen::SparseMatrix<double>(levels_.back().a));
+  if (coarse_.info() != Eigen::Success) throw std::runtime_error("multigrid: coarsest-level factorisation failed");
+}
+
+void AggregationMultigrid::cycle(int l, const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  if (l == int(levels_.size()) - 1) {
+    x = coarse_.solve(b);
+    return;
+  }
+  const Level& L = levels_[std::size_t(l)];
+  x.setZero(b.size());
+  gaussSeidel(L.a, b, x, true);
+  const Eigen::VectorXd r = b - L.a * x;
+  Eigen::VectorXd rc = Eigen::VectorXd::Zero(L.coarseCount), xc;
+  for (int i = 0; i < int(r.size()); ++i) rc[L.coarseOf[std::size_t(i)]] += r[i];
+  cycle(l + 1, rc, xc);
+  for (int i = 0; i < int(x.size()); ++i) x[i] += xc[L.coarseOf[std::size_t(i)]];
+  gaussSeidel(L.a, b, x, false);
+}
+
+void AggregationMultigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const { cycle(0, r, z); }
+
+}  // namespace rcfd::gas

@@ -1,0 +1,44 @@
+#pragma once
+/// \file AggregationMultigrid.hpp
+/// A geometric-aggregation multigrid V-cycle, used as the preconditioner of the pressure CG: level l+1
+/// merges the 2x2x2 blocks of level l's cells (a piecewise-constant prolongation P), A_{l+1} = P^T A_l P
+/// (Galerkin, so cut cells and alpha_G come along without geometry), symmetric Gauss-Seidel smoothing
+/// (forward before, backward after: the cycle is a symmetric operator, as CG needs), a sparse Cholesky
+/// on the coarsest level.
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace rcfd::gas {
+
+class AggregationMultigrid {
+ public:
+  using Matrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+  /// cellOf[r]: the grid cell (i, j, k) of unknown r; used to build the aggregates once.
+  explicit AggregationMultigrid(std::vector<std::array<int, 3>> cellOf);
+  ~AggregationMultigrid();
+
+  /// Builds the level matrices for A (same unknowns as cellOf).
+  void compute(const Matrix& a);
+  /// z = V-cycle applied to r (z = M^-1 r).
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
+  int levels() const { return int(levels_.size()); }
+
+ private:
+  struct Level {
+    Matrix a;
+    std::vector<int> coarseOf;  ///< aggregate of each unknown on the next level
+    int coarseCount = 0;
+  };
+  void cycle(int l, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+
+  std::vector<std::array<int, 3>> cellOf_;
+  std::vector<Level> levels_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarse_;
+};
+
+}  // namespace rcfd::gas

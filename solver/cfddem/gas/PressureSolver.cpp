@@ -1,0 +1,136 @@
+// Preconditioned conjugate gradients for the pressure equation (declared in PressureSolver.hpp).
+
+#include "cfddem/gas/PressureSolver.hpp"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <cmath>
+#include <stdexcept>
+
+namespace rcfd::gas {
+
+Preconditioner parsePreconditioner(const std::string& name) {
+  if (name == "ic") return Preconditioner::IncompleteCholesky;
+  if (name == "jacobi") return Preconditioner::Jacobi;
+  if (name == "mg") return Preconditioner::Multigrid;
+  throw std::invalid_argument("unknown pressure preconditioner \"" + name + "\"; valid names are: ic jacobi mg");
+}
+
+struct PressureSolver::IcHolder {
+  // Natural ordering keeps the lexicographic order of the grid, for which IC works well on a 7-point
+  // Laplacian; Eigen's IC adds a diagonal shift by itself if a pivot turns non-positive.
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> factor;
+};
+
+PressureSolver::PressureSolver(Preconditioner kind, int refactorInterval)
+    : kind_(kind), refactorInterval_(refactorInterval) {}
+
+PressureSolver::~PressureSolver() = default;
+
+void PressureSolver::setCells(std::vector<std::array<int, 3>> cellOf) {
+  cells_ = std::move(cellOf);
+  mg_.reset();
+}
+
+void PressureSolver::setMatrix(const Matrix& a, bool force) {
+  const bool newPattern = a.rows() != a_.rows() || a.nonZeros() != a_.nonZeros();
+  a_ = a;
+  inverseDiagonal_ = a_.diagonal().cwiseInverse();
+  if (kind_ == Preconditioner::Multigrid) {
+    if (!mg_ || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
+      if (cells_.size() != std::size_t(a_.rows())) throw std::logic_error("multigrid: setCells() not called");
+      if (!mg_) mg_ = std::make_unique<AggregationMultigrid>(cells_);
+      mg_->compute(a_);
+      sinceFactor_ = 0;
+    }
+    return;
+  }
+  if (kind_ != Preconditioner::IncompleteCholesky) return;
+  if (!ic_ || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
+    if (!ic_) ic_ = std::make_unique<IcHolder>();
+    Eigen::SparseMatrix<double> colMajor = a_;
+    ic_->factor.compute(colMajor);
+    if (ic_->factor.info() != Eigen::Success) throw std::runtime_error("incomplete Cholesky of the pressure matrix failed");
+    sinceFactor_ = 0;
+  }
+}
+
+void PressureSolver::applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
+  if (kind_ == Preconditioner::IncompleteCholesky) z = ic_->factor.solve(r);
+  else if (kind_ == Preconditioner::Multigrid) mg_->apply(r, z);
+  else z = inverseDiagonal_.cwiseProduct(r);
+}
+
+namespace {
+
+/// Below this many rows the OpenMP fork/join costs more than the loop (and, on a loaded machine, a
+/// descheduled thread stalls every barrier of every CG iteration).
+constexpr long kParallelRows = 150000;
+
+/// y = A x with the rows split over the OpenMP threads (Eigen runs sparse products serially).
+void multiply(const PressureSolver::Matrix& a, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const int n = int(a.rows());
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* val = a.valuePtr();
+#pragma omp parallel for schedule(static) if (n > kParallelRows)
+  for (int r = 0; r < n; ++r) {
+    double s = 0.0;
+    for (int q = outer[r]; q < outer[r + 1]; ++q) s += val[q] * x[inner[q]];
+    y[r] = s;
+  }
+}
+
+double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const long n = a.size();
+  double s = 0.0;
+#pragma omp parallel for reduction(+ : s) schedule(static) if (n > kParallelRows)
+  for (long i = 0; i < n; ++i) s += a[i] * b[i];
+  return s;
+}
+
+}  // namespace
+
+PressureSolveStats PressureSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, double absTol,
+                                         int maxIterations) {
+  PressureSolveStats stats;
+  const long n = b.size();
+  Eigen::VectorXd r(n), z(n), p(n), q(n);
+  multiply(a_, x, q);
+  r = b - q;
+  double rr = dot(r, r);
+  stats.residual = std::sqrt(rr);
+  if (stats.residual <= absTol) {
+    stats.converged = true;
+    return stats;
+  }
+  applyPreconditioner(r, z);
+  p = z;
+  double rz = dot(r, z);
+  for (int it = 1; it <= maxIterations; ++it) {
+    multiply(a_, p, q);
+    const double alpha = rz / dot(p, q);
+    x += alpha * p;
+    r -= alpha * q;
+    rr = dot(r, r);
+    stats.iterations = it;
+    stats.residual = std::sqrt(rr);
+    if (!std::isfinite(stats.residual)) return stats;
+    if (stats.residual <= absTol) {
+      // The recursive residual drifts from the true one over many iterations: confirm it.
+      multiply(a_, x, q);
+      r = b - q;
+      stats.residual = r.norm();
+      if (stats.residual <= absTol) {
+        stats.converged = true;
+        return stats;
+      }
+    }
+    applyPreconditioner(r, z);
+    const double rzNew = dot(r, z);
+    p = z + (rzNew / rz) * p;
+    rz = rzNew;
+  }
+  return stats;
+}
+
+}  // namespace rcfd::gas
