@@ -123,6 +123,11 @@ Response JobsApi::submit(const Request& req, const Target& target) {
   } catch (const InputError& e) {
     return invalidInput(e, target.path);
   }
+  if (spec.kind != "database" && spec.database.empty())
+    return invalidInput(InputError("job", "/database",
+                                   "required for " + spec.kind +
+                                       " jobs: the id of a database job or an uploaded database"),
+                        target.path);
   if (!spec.database.empty()) {
     const DatabaseRef ref = resolveDatabaseRef(store_, config_, spec.database);
     if (ref.status == DatabaseRef::Status::unknown || ref.status == DatabaseRef::Status::failed)

@@ -128,6 +128,16 @@ int main(int argc, char** argv) {
     net::io_context ioc(ioThreads);
     net::thread_pool blocking(2);
     auto listener = std::make_shared<Listener>(ioc, parseListen(listen), router, blocking);
+    // Signals are caught before the listening line is printed, so a supervisor that reads it can
+    // always stop the server gracefully.
+    net::signal_set signals(ioc, SIGINT, SIGTERM);
+    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      std::cerr << "rcfd-server: signal " << sig
+                << ": stopping; running solvers checkpoint and resume on the next start\n";
+      listener->stop();
+      ioc.stop();
+    });
     const auto bound = listener->endpoint();
     const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]"
                                                      : bound.address().to_string();
@@ -137,14 +147,6 @@ int main(int argc, char** argv) {
     pool.start();
     listener->run();
 
-    net::signal_set signals(ioc, SIGINT, SIGTERM);
-    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
-      if (ec) return;
-      std::cerr << "rcfd-server: signal " << sig
-                << ": stopping; running solvers checkpoint and resume on the next start\n";
-      listener->stop();
-      ioc.stop();
-    });
     std::vector<std::thread> threads;
     for (int i = 1; i < ioThreads; ++i) threads.emplace_back([&ioc] { ioc.run(); });
     ioc.run();

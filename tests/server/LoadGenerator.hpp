@@ -1,10 +1,12 @@
 #pragma once
 // A small loopback load generator (Boost.Beast, asynchronous): `connections` keep-alive connections
-// each sending GET `target` back to back until `duration` has passed. Used by tests/server/test_load
+// each sending GET `target` until `duration` has passed, either back to back (interval 0: measures
+// the server at saturation) or one request per `interval` per client (a polling client). Used by tests/server/test_load
 // (5 s) and bench/server_load.cpp (30 s). Header-only so both can include it.
 
 #include <algorithm>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -35,13 +37,14 @@ struct LoadShared {
   std::vector<double> latenciesMs;
   std::uint64_t errors = 0;
   std::chrono::steady_clock::time_point deadline;
+  std::chrono::milliseconds interval{0};
 };
 
 class LoadConnection : public std::enable_shared_from_this<LoadConnection> {
  public:
   LoadConnection(net::io_context& ioc, LoadShared& shared, net::ip::tcp::endpoint endpoint,
                  const std::string& target, const std::string& token)
-      : stream_(net::make_strand(ioc)), shared_(shared), endpoint_(endpoint) {
+      : stream_(net::make_strand(ioc)), timer_(stream_.get_executor()), shared_(shared), endpoint_(endpoint) {
     req_ = {http::verb::get, target, 11};
     req_.set(http::field::host, "127.0.0.1");
     req_.set(http::field::authorization, "Bearer " + token);
@@ -89,10 +92,14 @@ class LoadConnection : public std::enable_shared_from_this<LoadConnection> {
     latencies_.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - sent_).count());
     if (res_.result_int() != 200) ++errors_;
-    send();
+    if (shared_.interval.count() == 0) return send();
+    // A polling client: the next request one interval after this one was sent.
+    timer_.expires_at(sent_ + shared_.interval);
+    timer_.async_wait([self = shared_from_this()](beast::error_code) { self->send(); });
   }
 
   beast::tcp_stream stream_;
+  net::steady_timer timer_;
   LoadShared& shared_;
   net::ip::tcp::endpoint endpoint_;
   http::request<http::empty_body> req_;
@@ -106,12 +113,14 @@ class LoadConnection : public std::enable_shared_from_this<LoadConnection> {
 }  // namespace detail
 
 inline LoadResult runStatusLoad(unsigned short port, const std::string& token, const std::string& target,
-                                int connections, std::chrono::seconds duration, int threads) {
+                                int connections, std::chrono::seconds duration, int threads,
+                                std::chrono::milliseconds interval = std::chrono::milliseconds(0)) {
   namespace net = boost::asio;
   net::io_context ioc;
   detail::LoadShared shared;
   const auto start = std::chrono::steady_clock::now();
   shared.deadline = start + duration;
+  shared.interval = interval;
   const net::ip::tcp::endpoint endpoint(net::ip::make_address("127.0.0.1"), port);
   for (int i = 0; i < connections; ++i)
     std::make_shared<detail::LoadConnection>(ioc, shared, endpoint, target, token)->start();

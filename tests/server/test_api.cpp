@@ -68,7 +68,8 @@ TEST_F(Api, SchemaViolationIs422WithPointer) {
   const auto r = server_->post("/v1/jobs", job.dump());
   expectProblem(r, 422);
   bool found = false;
-  for (const auto& e : r.json().at("errors")) found = found || e.at("pointer") == "/kind";
+  const auto body = r.json();
+  for (const auto& e : body.at("errors")) found = found || e.at("pointer") == "/kind";
   EXPECT_TRUE(found) << r.body;
 
   auto unknown = databaseJob();
@@ -93,7 +94,8 @@ TEST_F(Api, UnknownOrFailedDatabaseReferenceIs422) {
   const auto r = server_->post("/v1/jobs", spray.dump());
   expectProblem(r, 422);
   bool found = false;
-  for (const auto& e : r.json().at("errors")) found = found || e.at("pointer") == "/database";
+  const auto body = r.json();
+  for (const auto& e : body.at("errors")) found = found || e.at("pointer") == "/database";
   EXPECT_TRUE(found) << r.body;
 
   // A cancelled database job cannot serve as a database either.
