@@ -82,6 +82,14 @@ void SvgDocument::line(double x0, double y0, double x1, double y1, const std::st
            "\"" + (dash.empty() ? "" : " stroke-dasharray=\"" + dash + "\"") + "/>\n";
 }
 
+void SvgDocument::translucentLine(double x0, double y0, double x1, double y1, const std::string& stroke,
+                                  double widthPx, double opacity, const std::string& dash) {
+  body_ += "<line x1=\"" + num(px(x0)) + "\" y1=\"" + num(py(y0)) + "\" x2=\"" + num(px(x1)) +
+           "\" y2=\"" + num(py(y1)) + "\" stroke=\"" + stroke + "\" stroke-width=\"" + num(widthPx) +
+           "\" stroke-opacity=\"" + num(opacity) + "\"" +
+           (dash.empty() ? "" : " stroke-dasharray=\"" + dash + "\"") + "/>\n";
+}
+
 void SvgDocument::polyline(const std::vector<std::array<double, 2>>& points, const std::string& stroke,
                            double widthPx) {
   body_ += "<polyline fill=\"none\" stroke=\"" + stroke + "\" stroke-width=\"" + num(widthPx) +

@@ -27,6 +27,9 @@ class SvgDocument {
 
   void line(double x0, double y0, double x1, double y1, const std::string& stroke = "#000",
             double widthPx = 1.0, const std::string& dash = "");
+  /// A line with stroke opacity in [0, 1] (translucent rays, e.g. a spray cone).
+  void translucentLine(double x0, double y0, double x1, double y1, const std::string& stroke,
+                       double widthPx, double opacity, const std::string& dash = "");
   void polyline(const std::vector<std::array<double, 2>>& points, const std::string& stroke = "#000",
                 double widthPx = 1.0);
   void polygon(const std::vector<std::array<double, 2>>& points, const std::string& fill,

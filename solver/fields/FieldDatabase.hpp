@@ -34,6 +34,23 @@ struct FrameCacheStats {
   std::int64_t residentBytes = 0;
 };
 
+/// Names in the HDF5 layout (CONTRACTS.md, docs/formats.md).
+namespace layout {
+inline constexpr const char* formatName = "rcfd-field-database";
+inline constexpr int version = 1;
+inline constexpr const char* scene = "/scene";
+inline constexpr const char* grid = "/grid";
+inline constexpr const char* fluidFraction = "/grid/fluid_fraction";
+inline constexpr const char* frames = "/frames";
+inline constexpr const char* alphaP = "/frames/alpha_p";
+inline constexpr const char* uP = "/frames/u_p";
+inline constexpr const char* uG = "/frames/u_g";
+/// Optional attribute of /frames: frames completely written, updated after each frame's data.
+inline constexpr const char* frameCountAttribute = "frame_count";
+inline constexpr const char* recurrenceMatrix = "/recurrence/matrix";
+inline constexpr int minimumFrames = 3;
+}  // namespace layout
+
 class FieldDatabase {
  public:
   /// Opens and validates a database; rcfd::InputError naming the dataset if it breaks the layout
@@ -51,6 +68,22 @@ class FieldDatabase {
   /// Frame `index` (0 <= index < frameCount()); safe to call from several threads.
   virtual std::shared_ptr<const FieldFrame> frame(int index) const = 0;
   virtual FrameCacheStats cacheStats() const = 0;
+  /// Bytes of one frame in memory (FieldFrame::bytes()).
+  std::int64_t frameBytes() const { return grid().cellCount() * 7 * std::int64_t(sizeof(float)); }
+};
+
+/// A database held in memory only (no file): tests and benchmarks of other areas. Validated like a
+/// file (sizes, fluid fraction in [0, 1], finite values, at least 3 frames); path() is "(memory)".
+std::shared_ptr<FieldDatabase> makeInMemoryDatabase(const CartesianGrid& grid,
+                                                    std::vector<float> fluidFraction, double dtRec,
+                                                    std::vector<FieldFrame> frames,
+                                                    std::string sceneJson = "{}");
+
+/// Storage options of a new database. HDF5's shuffle + deflate filters are off by default: on the
+/// paper-size benchmark they cost more load time than the smaller file saves (docs/performance.md).
+struct FieldDatabaseWriterOptions {
+  int deflateLevel = 0;  ///< 0: no compression; 1-9: deflate level
+  bool shuffle = false;  ///< byte shuffle before deflate
 };
 
 /// Appends frames to a new database file; each append is flushed so the file stays readable.
@@ -58,11 +91,14 @@ class FieldDatabaseWriter {
  public:
   FieldDatabaseWriter(const std::string& path, const CartesianGrid& grid,
                       const std::vector<float>& fluidFraction, double dtRec,
-                      const std::string& sceneJson);
+                      const std::string& sceneJson, FieldDatabaseWriterOptions options = {});
+  /// Closes the file if close() was not called (errors are swallowed there; call close() to see them).
   ~FieldDatabaseWriter();
   FieldDatabaseWriter(const FieldDatabaseWriter&) = delete;
   FieldDatabaseWriter& operator=(const FieldDatabaseWriter&) = delete;
 
+  /// Appends frame framesWritten(); refuses wrongly sized or non-finite frames (rcfd::InputError
+  /// naming the dataset). After it returns the frame is on disk (H5Fflush).
   void append(const FieldFrame& frame);
   int framesWritten() const;
   void close();

@@ -6,7 +6,26 @@
 /// and droplet parcels (reflection, exit through the outlet).
 ///
 /// Sign convention: signedDistance(p) > 0 inside the open (gas) region, < 0 inside a wall or outside
-/// the apparatus; normals point from the wall into the open region.
+/// the apparatus; normals point from the wall into the open region. Points on the boundary count as
+/// inside (contains() is true, signedDistance() is 0).
+///
+/// Tolerance contract of firstIntersection(): hits are reported against the open region shrunk by
+/// boundaryTolerance() (about 1e-9 of the apparatus size, i.e. sub-nanometre), so a reported hit point
+/// lies inside the open region, at most ~2 boundaryTolerance() from the wall it hit (signedDistance of
+/// the hit point >= 0 up to round-off of ~1e-16 m). A segment that starts inside that thin band and
+/// moves towards the wall gets a hit at t = 0 (point = a); one that moves parallel to or away from the
+/// wall gets none from that wall (a motion that leaves the wall's plane by less than ~1e-15 of the
+/// apparatus size counts as parallel: round-off, and its end point is at most that far outside). So
+/// the usual loop
+///
+///   while (auto hit = apparatus.firstIntersection(a, b)) {        // cap the number of bounces
+///     const Vector3d rest = b - hit->point;
+///     a = hit->point; b = a + rest - 2 * rest.dot(hit->normal) * hit->normal;   // mirror
+///   }
+///
+/// never leaves the apparatus: every a it produces is a reported hit point, and a segment without a hit
+/// stays in the open region from a to b. Features thinner than the tolerance are inflated by it: a
+/// segment passing a draft plate's tip at less than boundaryTolerance() counts as a hit on the plate.
 
 #include <Eigen/Core>
 #include <optional>
@@ -49,6 +68,9 @@ struct SectionEdge {
 
 class Apparatus {
  public:
+  /// Builds the walls; throws rcfd::InputError naming the JSON pointer (e.g.
+  /// "/apparatus/draft_plates/elevation") when the dimensions are inconsistent: non-positive sizes, an
+  /// inlet at least as wide as the chamber, a chamber not taller than the V, plates that do not fit.
   explicit Apparatus(const ApparatusSpec& spec);
 
   const ApparatusSpec& spec() const { return spec_; }
@@ -62,8 +84,20 @@ class Apparatus {
   double signedDistance(const Eigen::Vector3d& p) const;
   NearestBoundary nearestBoundary(const Eigen::Vector3d& p) const;
 
-  /// First boundary the segment a->b crosses (a must be inside), or nothing if b is reachable.
+  /// First boundary the segment a->b crosses, or nothing if the whole segment stays in the open region
+  /// (then b is inside). `a` must be inside or on the boundary (signedDistance(a) >= -boundaryTolerance());
+  /// for a start point farther outside the result is unspecified: project it back first with
+  /// nearestBoundary(). Allocation-free. See the file comment for the tolerance contract.
   std::optional<BoundaryHit> firstIntersection(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+
+  /// Width of the band inside the walls in which firstIntersection() reports hits [m].
+  double boundaryTolerance() const { return tol_; }
+
+  /// prismatic_spouted_bed: height y_v where the V walls meet the vertical side walls,
+  /// (width - inlet_width) / 2 * tan(prism angle) [m]; box: 0.
+  double vWallTop() const { return yV_; }
+  /// Height of the chamber floor (the V walls, the inlet, or the box bottom) at lateral position x [m].
+  double floorHeight(double x) const;
 
   /// Exact open volume of the chamber [m3] (cross-section area times depth).
   double openVolume() const;
@@ -72,16 +106,57 @@ class Apparatus {
 
   /// The cross-section's outer boundary (counter-clockwise) and plate outlines, for drawing.
   const std::vector<SectionEdge>& sectionEdges() const { return edges_; }
+  /// The outer polygon (counter-clockwise; convex for both apparatus types) [m].
+  const std::vector<Eigen::Vector2d>& outline() const { return outline_; }
+  /// The draft plates' rectangles (clockwise, so the open region is on the left of every edge) [m].
+  const std::vector<std::vector<Eigen::Vector2d>>& holes() const { return holes_; }
 
  private:
+  /// One edge of the convex outline as a half-plane: n . p - c >= 0 inside, n the unit inward normal.
+  struct HalfPlane {
+    Eigen::Vector2d n;
+    double c = 0.0;
+    BoundaryKind kind = BoundaryKind::Wall;
+  };
+  /// A draft plate: an axis-aligned rectangle spanning the whole depth.
+  struct PlateBox {
+    Eigen::Vector2d lo, hi;
+  };
+  /// Signed 2D distance to the cross-section (> 0 inside) with the nearest point, normal and kind.
+  double section2d(const Eigen::Vector2d& p, Eigen::Vector2d& q, Eigen::Vector2d& n,
+                   BoundaryKind& kind) const;
+
   ApparatusSpec spec_;
   std::vector<Eigen::Vector2d> outline_;               ///< counter-clockwise outer polygon
   std::vector<std::vector<Eigen::Vector2d>> holes_;    ///< plates, each a rectangle
   std::vector<SectionEdge> edges_;
+  std::vector<HalfPlane> planes_;  ///< one per outline edge, same order
+  std::vector<PlateBox> plates_;
+  double depth_ = 0.0;
+  double yV_ = 0.0;
+  double tol_ = 0.0;
+  double noise_ = 0.0;  ///< round-off of coordinate differences: outward motion below this is parallel
+  double sectionArea_ = 0.0;
+  Eigen::Vector2d lo2_ = Eigen::Vector2d::Zero(), hi2_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d platesLo_ = Eigen::Vector2d::Zero(), platesHi_ = Eigen::Vector2d::Zero();
 };
 
+/// Outcome of moveWithMirrorReflection().
+struct ReflectedMove {
+  Eigen::Vector3d end = Eigen::Vector3d::Zero();  ///< final position, inside or on the boundary [m]
+  int bounces = 0;                                ///< boundary hits on the way
+  bool capped = false;  ///< stopped at the last hit point after maxBounces hits (end is still inside)
+};
+
+/// Moves a point from a towards b, mirror-reflecting the rest of the displacement at every boundary
+/// (walls, plates, inlet and outlet alike): the loop of the Apparatus file comment. `a` must be inside
+/// or on the boundary; the end point always is. Allocation-free.
+ReflectedMove moveWithMirrorReflection(const Apparatus& apparatus, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, int maxBounces = 64);
+
 /// The uniform grid of a scene over the apparatus's bounding box (cell size from the scene, rounded so
-/// that a whole number of cells spans each extent).
+/// that a whole number of cells spans each extent: n = max(1, round(extent / cell_size))).
+/// Throws rcfd::InputError (/grid/cell_size) for a non-positive or non-finite cell size.
 CartesianGrid makeGrid(const Apparatus& apparatus, const GridSpec& spec);
 
 /// Open volume fraction of every cell (C order, x fastest), in [0, 1], from exact clipping of the

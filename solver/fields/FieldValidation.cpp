@@ -1,0 +1,103 @@
+#include "fields/FieldValidation.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace rcfd {
+
+namespace {
+std::string str(double v) {
+  std::ostringstream out;
+  out.precision(9);
+  out << v;
+  return out.str();
+}
+
+// First non-finite entry of `values` (flat index), or -1.
+std::int64_t firstNonFinite(const std::vector<float>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) return std::int64_t(i);
+  }
+  return -1;
+}
+}  // namespace
+
+void validateGrid(const CartesianGrid& grid, std::vector<Violation>& violations) {
+  const char* axis[3] = {"x", "y", "z"};
+  for (int d = 0; d < 3; ++d) {
+    if (!std::isfinite(grid.origin[d])) {
+      violations.push_back({"/grid@origin", std::string(axis[d]) + " is " + str(grid.origin[d]) +
+                                                "; it must be a finite number [m]"});
+    }
+    if (!(std::isfinite(grid.spacing[d]) && grid.spacing[d] > 0.0)) {
+      violations.push_back({"/grid@spacing", std::string(axis[d]) + " is " + str(grid.spacing[d]) +
+                                                 "; it must be finite and > 0 [m]"});
+    }
+    if (grid.shape[d] < 1) {
+      violations.push_back({"/grid@shape", std::string("n") + axis[d] + " is " +
+                                               std::to_string(grid.shape[d]) + "; it must be >= 1"});
+    }
+  }
+}
+
+void validateFluidFraction(const std::vector<float>& fluidFraction, const CartesianGrid& grid,
+                           std::vector<Violation>& violations) {
+  if (std::int64_t(fluidFraction.size()) != grid.cellCount()) {
+    violations.push_back({"/grid/fluid_fraction", "has " + std::to_string(fluidFraction.size()) +
+                                                      " values; the grid has " +
+                                                      std::to_string(grid.cellCount()) + " cells"});
+    return;
+  }
+  for (std::size_t c = 0; c < fluidFraction.size(); ++c) {
+    const float f = fluidFraction[c];
+    if (!(f >= 0.0f && f <= 1.0f)) {  // also catches NaN
+      const auto ijk = grid.cellIjk(std::int64_t(c));
+      violations.push_back({"/grid/fluid_fraction",
+                            "cell (" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " +
+                                std::to_string(ijk[2]) + ") is " + str(f) +
+                                "; the open volume fraction must be in [0, 1]"});
+      return;  // one example is enough; a broken field usually breaks many cells
+    }
+  }
+}
+
+void validateDtRec(double dtRec, std::vector<Violation>& violations) {
+  if (!(std::isfinite(dtRec) && dtRec > 0.0)) {
+    violations.push_back({"/@dt_rec", "is " + str(dtRec) + "; the sampling interval must be finite and > 0 [s]"});
+  }
+}
+
+void checkFrame(const FieldFrame& frame, int index, const CartesianGrid& grid, const std::string& source) {
+  const std::int64_t cells = grid.cellCount();
+  std::vector<Violation> violations;
+  struct Part {
+    const char* name;
+    const std::vector<float>* values;
+    int components;
+  };
+  const Part parts[3] = {{"/frames/alpha_p", &frame.alpha_p, 1},
+                         {"/frames/u_p", &frame.u_p, 3},
+                         {"/frames/u_g", &frame.u_g, 3}};
+  for (const auto& p : parts) {
+    if (std::int64_t(p.values->size()) != cells * p.components) {
+      violations.push_back({p.name, "frame " + std::to_string(index) + " has " +
+                                        std::to_string(p.values->size()) + " values; expected " +
+                                        std::to_string(cells * p.components) + " (" +
+                                        std::to_string(cells) + " cells x " +
+                                        std::to_string(p.components) + ")"});
+      continue;
+    }
+    const std::int64_t bad = firstNonFinite(*p.values);
+    if (bad >= 0) {
+      const auto ijk = grid.cellIjk(bad / p.components);
+      violations.push_back({p.name, "frame " + std::to_string(index) + ", cell (" +
+                                        std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " +
+                                        std::to_string(ijk[2]) + ") holds " +
+                                        str((*p.values)[std::size_t(bad)]) +
+                                        "; every value must be finite"});
+    }
+  }
+  if (!violations.empty()) throw InputError(source, std::move(violations));
+}
+
+}  // namespace rcfd

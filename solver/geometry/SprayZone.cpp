@@ -1,0 +1,135 @@
+#include "geometry/SprayZone.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+#include <numbers>
+#include <sstream>
+
+#include "core/Errors.hpp"
+#include "geometry/Apparatus.hpp"
+
+namespace rcfd {
+namespace {
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+/// Integral of the half-chord h(t) = sqrt(r^2 - t^2) of a disk of radius r from -r to t (|t| <= r).
+double halfChordIntegral(double t, double r) {
+  const double h = std::sqrt(std::max(0.0, r * r - t * t));
+  return 0.5 * (t * h + r * r * std::asin(std::clamp(t / r, -1.0, 1.0))) + 0.25 * std::numbers::pi * r * r;
+}
+
+/// Area of the disk of radius r centred at the origin with X <= x and Z <= z.
+double quadrantArea(double x, double z, double r) {
+  if (z <= -r || x <= -r) return 0.0;
+  const double X = std::min(x, r);
+  auto H = [r](double t) { return halfChordIntegral(t, r); };
+  if (z >= r) return 2.0 * H(X);
+  // Where |t| > c the chord lies entirely below z (z > 0) or above it (z < 0); for |t| < c it is cut.
+  const double c = std::sqrt(r * r - z * z);
+  double area = 0.0;
+  const double a1 = std::min(X, -c);  // [-r, -c]
+  if (z > 0.0) area += 2.0 * (H(a1) - H(-r));
+  if (X > -c) {
+    const double b = std::min(X, c);  // [-c, c]: chord from -h to z
+    area += z * (b + c) + H(b) - H(-c);
+  }
+  if (X > c && z > 0.0) area += 2.0 * (H(X) - H(c));  // [c, r]
+  return area;
+}
+
+/// Area of the disk (centre (cx, cz), radius r) inside the rectangle [x0, x1] x [z0, z1].
+double diskRectangleArea(double cx, double cz, double r, double x0, double x1, double z0, double z1) {
+  if (r <= 0.0 || x1 <= x0 || z1 <= z0) return 0.0;
+  x0 -= cx, x1 -= cx, z0 -= cz, z1 -= cz;
+  return quadrantArea(x1, z1, r) - quadrantArea(x0, z1, r) - quadrantArea(x1, z0, r) + quadrantArea(x0, z0, r);
+}
+
+}  // namespace
+
+SprayZone::SprayZone(const SprayZoneSpec& spec) : spec_(spec) {
+  std::vector<Violation> bad;
+  const std::string base = "/spray/spray_zone/";
+  if (!(std::isfinite(spec.half_angle_deg) && spec.half_angle_deg > 0.0 && spec.half_angle_deg < 90.0))
+    bad.push_back({base + "half_angle_deg", fmt(spec.half_angle_deg) + " must lie in (0, 90) degrees"});
+  if (!spec.apex.allFinite()) bad.push_back({base + "apex", "must be three finite numbers [m]"});
+  if (!(std::isfinite(spec.y_min) && std::isfinite(spec.y_max) && spec.y_min < spec.y_max))
+    bad.push_back({base + "y_max", fmt(spec.y_max) + " m must exceed y_min = " + fmt(spec.y_min) + " m"});
+  if (std::isfinite(spec.y_min) && spec.y_min < spec.apex.y())
+    bad.push_back({base + "y_min", fmt(spec.y_min) + " m lies below the cone's apex at y = " +
+                                       fmt(spec.apex.y()) + " m; it must be >= the apex height"});
+  if (!bad.empty()) throw InputError("spray zone", bad);
+  tanHalfAngle_ = std::tan(spec.half_angle_deg * std::numbers::pi / 180.0);
+}
+
+double SprayZone::radiusAt(double y) const {
+  return y <= spec_.apex.y() ? 0.0 : (y - spec_.apex.y()) * tanHalfAngle_;
+}
+
+bool SprayZone::contains(const Eigen::Vector3d& p) const {
+  if (p.y() < spec_.y_min || p.y() > spec_.y_max) return false;
+  const double dx = p.x() - spec_.apex.x(), dz = p.z() - spec_.apex.z();
+  const double r = radiusAt(p.y());
+  return dx * dx + dz * dz <= r * r;
+}
+
+double SprayZone::volume() const {
+  const double h1 = spec_.y_max - spec_.apex.y(), h0 = spec_.y_min - spec_.apex.y();
+  return std::numbers::pi * tanHalfAngle_ * tanHalfAngle_ / 3.0 * (h1 * h1 * h1 - h0 * h0 * h0);
+}
+
+double SprayZone::volumeInside(const Apparatus& apparatus, int slices) const {
+  const auto& outline = apparatus.outline();
+  const double depth = apparatus.depth();
+  const double cx = spec_.apex.x(), cz = spec_.apex.z();
+  // Open area of the zone's disk at height y: the outline's x-range at y (convex: one interval) times
+  // [0, depth], minus the plates at that height.
+  auto area = [&](double y) {
+    double xl = -std::numeric_limits<double>::infinity(), xr = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < outline.size(); ++i) {
+      const Eigen::Vector2d e = outline[(i + 1) % outline.size()] - outline[i];
+      const Eigen::Vector2d n(-e.y(), e.x());  // inward for the counter-clockwise outline
+      const double c = n.dot(outline[i]) - n.y() * y;  // n.x x >= c
+      if (n.x() > 0.0) xl = std::max(xl, c / n.x());
+      else if (n.x() < 0.0) xr = std::min(xr, c / n.x());
+      else if (c > 0.0) return 0.0;
+    }
+    const double r = radiusAt(y);
+    double a = diskRectangleArea(cx, cz, r, xl, xr, 0.0, depth);
+    for (const auto& hole : apparatus.holes()) {
+      double hx0 = hole[0].x(), hx1 = hole[0].x(), hy0 = hole[0].y(), hy1 = hole[0].y();
+      for (const auto& p : hole) {
+        hx0 = std::min(hx0, p.x()), hx1 = std::max(hx1, p.x());
+        hy0 = std::min(hy0, p.y()), hy1 = std::max(hy1, p.y());
+      }
+      if (y > hy0 && y < hy1) a -= diskRectangleArea(cx, cz, r, std::max(hx0, xl), std::min(hx1, xr), 0.0, depth);
+    }
+    return std::max(0.0, a);
+  };
+  // Split at the heights where the open section changes shape (plate edges, outline corners), so
+  // Simpson integrates smooth pieces.
+  std::vector<double> cuts{spec_.y_min, spec_.y_max};
+  for (const auto& p : outline) cuts.push_back(p.y());
+  for (const auto& hole : apparatus.holes())
+    for (const auto& p : hole) cuts.push_back(p.y());
+  std::sort(cuts.begin(), cuts.end());
+  double volume = 0.0;
+  const int perPiece = std::max(2, slices / int(cuts.size()));
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double y0 = std::max(cuts[k], spec_.y_min), y1 = std::min(cuts[k + 1], spec_.y_max);
+    if (y1 <= y0) continue;
+    const int n = perPiece + perPiece % 2;  // even
+    const double h = (y1 - y0) / n;
+    double sum = area(y0) + area(y1);
+    for (int i = 1; i < n; ++i) sum += (i % 2 ? 4.0 : 2.0) * area(y0 + i * h);
+    volume += sum * h / 3.0;  // composite Simpson
+  }
+  return volume;
+}
+
+}  // namespace rcfd

@@ -1,0 +1,46 @@
+#include "jobs/RecurrenceSetup.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "core/Errors.hpp"
+
+namespace rcfd {
+
+RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databasePath, std::int64_t frames,
+                                  std::uint64_t seed) {
+  RecurrenceSetup setup;
+  {
+    // Peek at the frame count first: the matrix must be stored while no reader holds the file.
+    auto probe = FieldDatabase::open(databasePath, FrameStorage{std::int64_t(1) << 20});
+    const int n = probe->frameCount();
+    probe.reset();
+    if (auto stored = loadRecurrenceMatrix(databasePath, n)) {
+      setup.matrix = std::move(*stored);
+      setup.matrixWasStored = true;
+    }
+  }
+  setup.database = FieldDatabase::open(databasePath, FrameStorage{scene.rcfd.frame_cache_bytes});
+  if (!setup.matrixWasStored) {
+    setup.matrix = computeRecurrenceMatrix(*setup.database);
+    spdlog::info("recurrence matrix of {} frames computed in {:.2f} s", setup.database->frameCount(),
+                 setup.matrix.seconds);
+    try {
+      auto reopen = setup.database;
+      setup.database.reset();
+      reopen.reset();
+      storeRecurrenceMatrix(databasePath, setup.matrix);
+    } catch (const std::exception& e) {
+      spdlog::warn("could not store the recurrence matrix in {}: {}", databasePath, e.what());
+    }
+    if (!setup.database) setup.database = FieldDatabase::open(databasePath, FrameStorage{scene.rcfd.frame_cache_bytes});
+  }
+  if (!PathGeneratorRegistry::contains(scene.rcfd.path.type)) {
+    throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));
+  }
+  auto generator = PathGeneratorRegistry::create(scene.rcfd.path.type, scene.rcfd.path);
+  setup.path = generator->generate(setup.matrix.R, frames, seed);
+  setup.pathStats = pathStatistics(setup.path, setup.matrix.R);
+  return setup;
+}
+
+}  // namespace rcfd

@@ -1,0 +1,28 @@
+#pragma once
+/// \file RecurrenceSetup.hpp
+/// What calibration and spray jobs share before their tracers move: the database opened with the
+/// scene's frame storage, its recurrence matrix (read from the file when stored, computed and stored
+/// otherwise) and the recurrence path the scene asks for.
+
+#include <memory>
+
+#include "fields/FieldDatabase.hpp"
+#include "recurrence/RecurrenceMatrix.hpp"
+#include "recurrence/RecurrencePath.hpp"
+#include "scene/Scene.hpp"
+
+namespace rcfd {
+
+struct RecurrenceSetup {
+  std::shared_ptr<FieldDatabase> database;
+  RecurrenceMatrix matrix;
+  RecurrencePath path;
+  PathStatistics pathStats;
+  bool matrixWasStored = false;  ///< read from /recurrence/matrix instead of computed
+};
+
+/// Opens `databasePath`, gets its recurrence matrix and builds a path of at least `frames` entries.
+RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databasePath, std::int64_t frames,
+                                  std::uint64_t seed);
+
+}  // namespace rcfd

@@ -1,0 +1,100 @@
+// The "spray" job: a tracer simulation with the scene's effects on an existing database, for
+// `duration` simulated seconds, with checkpoints, resume and progress. (Spray deposition itself plugs in
+// as further effects.)
+#include <chrono>
+#include <filesystem>
+#include <spdlog/spdlog.h>
+
+#include "core/Errors.hpp"
+#include "jobs/Cancellation.hpp"
+#include "jobs/JobRunner.hpp"
+#include "jobs/Progress.hpp"
+#include "jobs/RecurrenceSetup.hpp"
+#include "tracers/TracerSimulation.hpp"
+
+namespace rcfd {
+namespace {
+
+class TracerJob final : public JobRunner {
+ public:
+  nlohmann::json run(const JobSpec& job, const RunOptions& options) override {
+    const Scene& scene = job.scene;
+    if (job.database.empty()) throw InputError("job", "/database", "a spray job needs a database");
+    const auto wallStart = std::chrono::steady_clock::now();
+    const std::int64_t steps = std::llround(job.duration / scene.rcfd.dt);
+    if (steps < 1) throw InputError("job", "/duration", "shorter than one time step rcfd.dt");
+
+    // The path is indexed per frame; dt may divide dt_rec, so size it for the number of frames used.
+    RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed);
+    TracerRunSettings settings{job.seed, steps, 0};
+    TracerSimulation sim(scene, rec.database, rec.path, settings);
+
+    const std::string checkpoint = options.outDir + "/checkpoint.h5";
+    double priorWall = 0.0;
+    if (std::filesystem::exists(checkpoint)) {
+      sim.loadCheckpoint(checkpoint);
+      h5::File f(checkpoint, h5::File::Mode::ReadOnly);
+      if (f.exists("/state/wall_time")) priorWall = f.readDoubles("/state/wall_time").at(0);
+      spdlog::info("resumed from {} at step {} of {}", checkpoint, sim.currentStep(), steps);
+    }
+    const std::int64_t checkpointEvery =
+        std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / scene.rcfd.dt));
+
+    ProgressReporter progress(options.progressJson, options.progressInterval);
+    progress.setPriorWallTime(priorWall);
+    progress.setStartFraction(double(sim.currentStep()) / double(steps));
+    auto save = [&] {
+      sim.saveCheckpoint(checkpoint);
+      h5::File f(checkpoint, h5::File::Mode::ReadWrite);
+      f.write("/state/wall_time", std::vector<double>{priorWall + progress.wallTime()});
+    };
+    const std::int64_t firstStep = sim.currentStep();
+    while (sim.currentStep() < steps) {
+      sim.step();
+      const std::int64_t s = sim.currentStep();
+      const bool stopForTest = options.stopAfterSteps >= 0 && s - firstStep >= options.stopAfterSteps;
+      if (cancellationRequested() || stopForTest) {
+        save();
+        throw Cancelled("stopped at step " + std::to_string(s) + " of " + std::to_string(steps) +
+                        "; checkpoint " + checkpoint);
+      }
+      if (s % checkpointEvery == 0 && s < steps) save();
+      progress.report(double(s) / double(steps), sim.time());
+    }
+    progress.report(1.0, sim.time(), true);
+
+    const double wall = priorWall + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    nlohmann::json summary = {{"kind", job.kind},
+                              {"status", "succeeded"},
+                              {"seed", job.seed},
+                              {"steps", steps},
+                              {"sim_time_s", sim.time()},
+                              {"dt", scene.rcfd.dt},
+                              {"effects", sim.effectNames()}};
+    {
+      const std::string resultTmp = options.outDir + "/result.h5.tmp";
+      h5::File out(resultTmp, h5::File::Mode::Create);
+      out.writeString("/scene", scene.source_json);
+      sim.writeResults(out, summary);
+      out.write("/path/frames", std::vector<std::int64_t>(rec.path.frames.begin(), rec.path.frames.end()));
+      out.flush();
+    }
+    std::filesystem::rename(options.outDir + "/result.h5.tmp", options.outDir + "/result.h5");
+    if (scene.outputs.svg) summary["figures"] = sim.writeFigures(options.outDir);
+    summary["path"] = {{"jumps", rec.pathStats.jumps},
+                       {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},
+                       {"mean_sequence_frames", rec.pathStats.meanSequenceLength}};
+    // Wall time and rates describe this machine, not the physics: the only keys allowed to differ
+    // between otherwise bit-identical runs.
+    summary["wall_time_s"] = wall;
+    summary["tracer_steps_per_s"] = wall > 0.0 ? double(sim.cloud().size()) * double(steps) / wall : 0.0;
+    std::filesystem::remove(checkpoint);
+    return summary;
+  }
+};
+
+const bool registered = JobRunnerRegistry::add("spray", "rCFD tracer run with the scene's effects",
+                                               [] { return std::make_unique<TracerJob>(); });
+
+}  // namespace
+}  // namespace rcfd

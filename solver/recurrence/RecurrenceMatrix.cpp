@@ -1,0 +1,363 @@
+#include "recurrence/RecurrenceMatrix.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/Errors.hpp"
+#include "fields/Hdf5.hpp"
+
+namespace rcfd {
+
+RecurrenceNorm parseRecurrenceNorm(const std::string& name, const std::string& pointer) {
+  if (name == "l2") return RecurrenceNorm::L2;
+  if (name == "l1") return RecurrenceNorm::L1;
+  if (name == "max") return RecurrenceNorm::Max;
+  throw InputError("recurrence", pointer, "\"" + name + "\" is not a norm; valid names are: l1 l2 max");
+}
+
+std::string toString(RecurrenceNorm norm) {
+  switch (norm) {
+    case RecurrenceNorm::L2: return "l2";
+    case RecurrenceNorm::L1: return "l1";
+    case RecurrenceNorm::Max: return "max";
+  }
+  return "l2";
+}
+
+FieldComponent parseFieldComponent(const std::string& name, const std::string& pointer) {
+  FieldComponent f;
+  f.name = name;
+  if (name == "alpha_p") return f;
+  if (name.size() == 5 && (name.rfind("u_p.", 0) == 0 || name.rfind("u_g.", 0) == 0)) {
+    const char axis = name[4];
+    if (axis >= 'x' && axis <= 'z') {
+      f.source = name[2] == 'p' ? FieldComponent::Source::UP : FieldComponent::Source::UG;
+      f.component = axis - 'x';
+      return f;
+    }
+  }
+  throw InputError("recurrence", pointer,
+                   "\"" + name + "\" is not a field; valid names are: alpha_p u_g.x u_g.y u_g.z u_p.x "
+                                 "u_p.y u_p.z");
+}
+
+ScalarSeries scalarSeries(const FieldDatabase& db, const FieldComponent& field) {
+  const auto& fluid = db.fluidFraction();
+  const double volume = db.grid().cellVolume();
+  auto cells = std::make_shared<std::vector<std::int64_t>>();
+  ScalarSeries s;
+  s.frames = db.frameCount();
+  for (std::size_t c = 0; c < fluid.size(); ++c) {
+    if (fluid[c] > 0.0f) {
+      cells->push_back(std::int64_t(c));
+      s.weights.push_back(double(fluid[c]) * volume);  // V_open,c [m3]
+    }
+  }
+  const FieldDatabase* source = &db;
+  s.fetch = [source, cells, field](int frame, float* out) {
+    const auto f = source->frame(frame);
+    for (std::size_t k = 0; k < cells->size(); ++k) out[k] = field.value(*f, (*cells)[k]);
+  };
+  return s;
+}
+
+namespace {
+
+struct Tile {
+  int first, count;
+};
+
+std::vector<Tile> tiles(int first, int count, int size) {
+  std::vector<Tile> out;
+  for (int t = 0; t < count; t += size) out.push_back({first + t, std::min(size, count - t)});
+  return out;
+}
+
+// Fetches frames [first, first + count) into columns, transformed by `store(column, values)`.
+template <class Store>
+void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
+  const std::size_t cells = s.weights.size();
+#pragma omp parallel
+  {
+    std::vector<float> buffer(cells);
+#pragma omp for schedule(dynamic, 1)
+    for (int f = 0; f < count; ++f) {
+      s.fetch(first + f, buffer.data());
+      store(f, buffer);
+    }
+  }
+}
+
+// Gram form of the L2 distances. Frames are centred on frame 0 (D is unchanged, (a_i - r) - (a_j - r)
+// = a_i - a_j) so n_i + n_j - 2 G_ij cancels less, then scaled by sqrt(V_c): G_ij = sum_c V_c x_i x_j.
+Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileFrames, std::int64_t* clamped) {
+  const int n = s.frames;
+  const Eigen::Index cells = Eigen::Index(s.weights.size());
+  std::vector<float> reference(s.weights.size());
+  s.fetch(0, reference.data());
+  Eigen::VectorXd sqrtW(cells);
+  for (Eigen::Index c = 0; c < cells; ++c) sqrtW[c] = std::sqrt(s.weights[std::size_t(c)]);
+
+  auto load = [&](int first, int count, Eigen::MatrixXd& X) {
+    X.resize(cells, count);
+    loadFrames(s, first, count, [&](int f, const std::vector<float>& v) {
+      double* col = X.col(f).data();
+      for (Eigen::Index c = 0; c < cells; ++c) col[c] = sqrtW[c] * (double(v[std::size_t(c)]) - reference[std::size_t(c)]);
+    });
+  };
+
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);  // upper triangle filled
+  Eigen::VectorXd norms(n);
+  const auto blocks = tiles(0, n, framesPerBlock);
+  Eigen::MatrixXd XP, XQ;
+  for (std::size_t p = 0; p < blocks.size(); ++p) {
+    load(blocks[p].first, blocks[p].count, XP);
+    norms.segment(blocks[p].first, blocks[p].count) = XP.colwise().squaredNorm().transpose();
+    for (std::size_t q = p; q < blocks.size(); ++q) {
+      if (q != p) load(blocks[q].first, blocks[q].count, XQ);
+      const Eigen::MatrixXd& Y = q == p ? XP : XQ;
+      const auto tp = tiles(0, blocks[p].count, tileFrames);
+      const auto tq = tiles(0, blocks[q].count, tileFrames);
+      std::vector<std::pair<int, int>> pairs;
+      for (int a = 0; a < int(tp.size()); ++a)
+        for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
+      // Each tile product is one single-threaded GEMM (Eigen does not nest inside omp parallel);
+      // only tiles on or above the diagonal are computed.
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int k = 0; k < int(pairs.size()); ++k) {
+        const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
+        const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
+        G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count).noalias() =
+            XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
+      }
+    }
+  }
+  std::int64_t negatives = 0;
+  Eigen::MatrixXd& D = G;  // converted in place, upper triangle first
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : negatives)
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      double d = norms[i] + norms[j] - 2.0 * D(i, j);
+      // Round-off can leave a tiny negative value for two nearly equal frames: it is a zero distance.
+      if (d < 0.0) {
+        d = 0.0;
+        ++negatives;
+      }
+      D(i, j) = d;
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    D(i, i) = 0.0;
+    for (int j = i + 1; j < n; ++j) D(j, i) = D(i, j);
+  }
+  if (clamped) *clamped = negatives;
+  return G;
+}
+
+// L1 (volume-weighted sum of |a_i - a_j|) and max (largest |a_i - a_j|) by a direct loop, blocked over
+// frames (memory) and cells (cache).
+Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int framesPerBlock, int tileFrames) {
+  const int n = s.frames;
+  const Eigen::Index cells = Eigen::Index(s.weights.size());
+  const double* w = s.weights.data();
+  constexpr Eigen::Index cellChunk = 1024;
+  using MatrixXfC = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
+  auto load = [&](int first, int count, MatrixXfC& X) {
+    X.resize(cells, count);
+    loadFrames(s, first, count, [&](int f, const std::vector<float>& v) {
+      std::copy(v.begin(), v.end(), X.col(f).data());
+    });
+  };
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+  const auto blocks = tiles(0, n, framesPerBlock);
+  MatrixXfC XP, XQ;
+  const bool isMax = norm == RecurrenceNorm::Max;
+  for (std::size_t p = 0; p < blocks.size(); ++p) {
+    load(blocks[p].first, blocks[p].count, XP);
+    for (std::size_t q = p; q < blocks.size(); ++q) {
+      if (q != p) load(blocks[q].first, blocks[q].count, XQ);
+      const MatrixXfC& Y = q == p ? XP : XQ;
+      const auto tp = tiles(0, blocks[p].count, tileFrames);
+      const auto tq = tiles(0, blocks[q].count, tileFrames);
+      std::vector<std::pair<int, int>> pairs;
+      for (int a = 0; a < int(tp.size()); ++a)
+        for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
+#pragma omp parallel for schedule(dynamic, 1)
+      for (int k = 0; k < int(pairs.size()); ++k) {
+        const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
+        const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
+        Eigen::MatrixXd acc = Eigen::MatrixXd::Zero(a.count, b.count);
+        for (Eigen::Index c0 = 0; c0 < cells; c0 += cellChunk) {
+          const Eigen::Index len = std::min(cellChunk, cells - c0);
+          for (int i = 0; i < a.count; ++i) {
+            const float* xi = XP.col(a.first + i).data() + c0;
+            const int gi = blocks[p].first + a.first + i;
+            for (int j = 0; j < b.count; ++j) {
+              const int gj = blocks[q].first + b.first + j;
+              if (gj <= gi) continue;
+              const float* xj = Y.col(b.first + j).data() + c0;
+              if (isMax) {
+                float m = 0.0f;
+#pragma omp simd reduction(max : m)
+                for (Eigen::Index c = 0; c < len; ++c) m = std::max(m, std::fabs(xi[c] - xj[c]));
+                acc(i, j) = std::max(acc(i, j), double(m));
+              } else {
+                double sum = 0.0;
+#pragma omp simd reduction(+ : sum)
+                for (Eigen::Index c = 0; c < len; ++c)
+                  sum += w[c0 + c] * std::fabs(double(xi[c]) - double(xj[c]));
+                acc(i, j) += sum;
+              }
+            }
+          }
+        }
+        for (int i = 0; i < a.count; ++i)
+          for (int j = 0; j < b.count; ++j) {
+            const int gi = blocks[p].first + a.first + i, gj = blocks[q].first + b.first + j;
+            if (gj > gi) D(gi, gj) = D(gj, gi) = acc(i, j);
+          }
+      }
+    }
+  }
+  return D;
+}
+
+}  // namespace
+
+Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
+                               std::int64_t memoryBudgetBytes, int tileFrames, int* blocks,
+                               std::int64_t* clamped) {
+  const int n = series.frames;
+  if (n < 1 || series.weights.empty()) {
+    throw InputError("recurrence", "/frames", "no frames or no open cells to compare");
+  }
+  tileFrames = std::max(1, tileFrames);
+  const std::int64_t bytesPerFrame =
+      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 ? 8 : 4);
+  // Two blocks are resident at a time (rows P and columns Q of the block pair).
+  std::int64_t perBlock = std::max<std::int64_t>(1, memoryBudgetBytes / (2 * bytesPerFrame));
+  int framesPerBlock = int(std::min<std::int64_t>(n, std::max<std::int64_t>(perBlock, 1)));
+  if (blocks) *blocks = (n + framesPerBlock - 1) / framesPerBlock;
+  if (clamped) *clamped = 0;
+  if (norm == RecurrenceNorm::L2) return l2Distances(series, framesPerBlock, tileFrames, clamped);
+  return directDistances(series, norm, framesPerBlock, tileFrames);
+}
+
+RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D) {
+  RecurrenceMatrix m;
+  const double maxD = D.size() ? D.maxCoeff() : 0.0;
+  m.normalisation = maxD;
+  if (maxD > 0.0) {
+    m.R = (1.0 - D.array() / maxD).matrix().cast<float>();  // Eq. (6) with N_alphaG of Eq. (7)
+  } else {
+    m.R = Eigen::MatrixXf::Ones(D.rows(), D.cols());  // every frame equal: all states recur
+  }
+  m.R.diagonal().setOnes();
+  return m;
+}
+
+RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const RecurrenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  int blocks = 1;
+  std::int64_t clamped = 0;
+  const Eigen::MatrixXd D =
+      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped);
+  RecurrenceMatrix m = normaliseDistances(D);
+  m.norm = options.norm;
+  m.field = options.field;
+  m.frameBlocks = blocks;
+  m.clampedNegatives = clamped;
+  m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return m;
+}
+
+RecurrenceMatrix computeRecurrenceMatrix(const FieldDatabase& db, const RecurrenceOptions& options) {
+  const FieldComponent field = parseFieldComponent(options.field);
+  return computeRecurrenceMatrix(scalarSeries(db, field), options);
+}
+
+void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatrix& matrix) {
+  using hdf5::Handle;
+  hdf5::silenceErrors();
+  Handle file(H5Fopen(databasePath.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+  if (!file.valid()) {
+    throw RunError(databasePath + ": cannot open for writing /recurrence/matrix (read-only, or open "
+                                  "elsewhere)");
+  }
+  if (!hdf5::linkExists(file, "/recurrence")) {
+    Handle g = hdf5::check(H5Gcreate2(file, "/recurrence", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                           databasePath + ": creating /recurrence");
+  }
+  const hsize_t dims[2] = {hsize_t(matrix.R.rows()), hsize_t(matrix.R.cols())};
+  Handle set;
+  if (hdf5::linkExists(file, layout::recurrenceMatrix)) {
+    set = Handle(H5Dopen2(file, layout::recurrenceMatrix, H5P_DEFAULT));
+    const auto old = set.valid() ? hdf5::datasetDims(set) : std::vector<hsize_t>{};
+    if (old != std::vector<hsize_t>{dims[0], dims[1]}) {
+      set.reset();
+      H5Ldelete(file, layout::recurrenceMatrix, H5P_DEFAULT);
+    }
+  }
+  if (!set.valid()) {
+    Handle space = hdf5::check(H5Screate_simple(2, dims, nullptr), "/recurrence/matrix");
+    set = hdf5::check(H5Dcreate2(file, layout::recurrenceMatrix, H5T_IEEE_F32LE, space, H5P_DEFAULT,
+                                 H5P_DEFAULT, H5P_DEFAULT),
+                      databasePath + ": creating /recurrence/matrix");
+  }
+  // R is symmetric, so Eigen's column-major storage is also the row-major [N][N] layout.
+  hdf5::checkStatus(H5Dwrite(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, matrix.R.data()),
+                    databasePath + ": writing /recurrence/matrix");
+  hdf5::writeStringAttribute(set, "norm", toString(matrix.norm));
+  hdf5::writeStringAttribute(set, "field", matrix.field);
+  hdf5::writeDoubleAttribute(set, "normalisation", {matrix.normalisation});
+  set.reset();
+  if (H5Fclose(file.release()) < 0) throw RunError(databasePath + ": closing after writing the matrix failed");
+}
+
+std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
+  using hdf5::Handle;
+  hdf5::silenceErrors();
+  Handle file(H5Fopen(databasePath.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  if (!file.valid() || !hdf5::linkExists(file, layout::recurrenceMatrix)) return std::nullopt;
+  Handle set(H5Dopen2(file, layout::recurrenceMatrix, H5P_DEFAULT));
+  if (!set.valid() || hdf5::datasetClass(set) != H5T_FLOAT) return std::nullopt;
+  if (hdf5::datasetDims(set) != std::vector<hsize_t>{hsize_t(expectedFrames), hsize_t(expectedFrames)})
+    return std::nullopt;
+  RecurrenceMatrix m;
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> R(expectedFrames, expectedFrames);
+  if (H5Dread(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, R.data()) < 0) return std::nullopt;
+  m.R = R;
+  if (auto n = hdf5::readStringAttribute(set, "norm")) m.norm = parseRecurrenceNorm(*n, "/recurrence/matrix@norm");
+  if (auto f = hdf5::readStringAttribute(set, "field")) m.field = *f;
+  if (auto v = hdf5::readNumericAttribute(set, "normalisation"); v && v->size() == 1) m.normalisation = (*v)[0];
+  return m;
+}
+
+RecurrenceSummary summariseRecurrence(const Eigen::MatrixXf& R, int maxLags) {
+  RecurrenceSummary s;
+  const Eigen::Index n = R.rows();
+  s.diagonalMeans.assign(std::size_t(n), 0.0);
+  double offSum = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    double sum = 0.0;
+    for (Eigen::Index i = 0; i + k < n; ++i) sum += R(i, i + k);
+    s.diagonalMeans[std::size_t(k)] = sum / double(n - k);
+    if (k > 0) offSum += 2.0 * sum;
+  }
+  s.meanOffDiagonal = n > 1 ? offSum / double(n * n - n) : 0.0;
+  const auto& m = s.diagonalMeans;
+  for (Eigen::Index k = 2; k <= n / 2 && k + 1 < n; ++k) {
+    if (m[std::size_t(k)] > m[std::size_t(k - 1)] && m[std::size_t(k)] >= m[std::size_t(k + 1)]) {
+      s.strongestLags.push_back({int(k), m[std::size_t(k)]});
+    }
+  }
+  std::stable_sort(s.strongestLags.begin(), s.strongestLags.end(),
+                   [](const RecurrenceLag& a, const RecurrenceLag& b) { return a.meanR > b.meanR; });
+  if (int(s.strongestLags.size()) > maxLags) s.strongestLags.resize(std::size_t(maxLags));
+  return s;
+}
+
+}  // namespace rcfd

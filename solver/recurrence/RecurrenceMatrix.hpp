@@ -1,0 +1,113 @@
+#pragma once
+/// \file RecurrenceMatrix.hpp
+/// The continuous recurrence plot of Eq. (6)-(7):
+///   R(i, j) = 1 - D(i, j) / max D,  D(i, j) = sum_c V_c (a_i,c - a_j,c)^2
+/// with V_c the open volume of cell c (fluid fraction x cell volume) and a the compared field
+/// (alpha_P by default: the paper's alpha_G = 1 - alpha_P gives the same differences). The L2 norm is
+/// computed through the Gram matrix, D = n_i + n_j - 2 G_ij with G = X^T W X, in double precision,
+/// blocked over frames so only a memory budget's worth of frames is converted at a time. The L1 norm
+/// (sum_c V_c |a_i - a_j|) and the max norm (max_c |a_i - a_j| over open cells) follow
+/// CFDEMcoupling-PFM's absDiffNorm and maxNorm; they have no Gram form and use a blocked direct loop.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fields/FieldDatabase.hpp"
+
+namespace rcfd {
+
+enum class RecurrenceNorm { L2, L1, Max };
+
+/// "l2", "l1" or "max"; rcfd::InputError naming `pointer` otherwise.
+RecurrenceNorm parseRecurrenceNorm(const std::string& name, const std::string& pointer = "--norm");
+std::string toString(RecurrenceNorm norm);
+
+/// A scalar per cell taken from a frame: alpha_p, or one component of u_p or u_g ("u_p.y").
+struct FieldComponent {
+  enum class Source { AlphaP, UP, UG };
+  Source source = Source::AlphaP;
+  int component = 0;  ///< 0, 1, 2 for x, y, z (velocities)
+  std::string name = "alpha_p";
+
+  float value(const FieldFrame& frame, std::int64_t cell) const {
+    switch (source) {
+      case Source::AlphaP: return frame.alpha_p[std::size_t(cell)];
+      case Source::UP: return frame.u_p[std::size_t(3 * cell + component)];
+      case Source::UG: return frame.u_g[std::size_t(3 * cell + component)];
+    }
+    return 0.0f;
+  }
+};
+
+/// "alpha_p", "u_p.x|y|z", "u_g.x|y|z"; rcfd::InputError naming `pointer` otherwise.
+FieldComponent parseFieldComponent(const std::string& name, const std::string& pointer = "--field");
+
+/// The frames as seen by the matrix: `frames` snapshots of weights.size() values each.
+struct ScalarSeries {
+  int frames = 0;
+  std::vector<double> weights;  ///< V_c per compared cell [m3]
+  /// Writes the weights.size() values of frame `frame` to `out`; called from several threads.
+  std::function<void(int frame, float* out)> fetch;
+};
+
+/// The open cells (fluid fraction > 0) of a database and the chosen field on them.
+ScalarSeries scalarSeries(const FieldDatabase& db, const FieldComponent& field);
+
+struct RecurrenceOptions {
+  RecurrenceNorm norm = RecurrenceNorm::L2;
+  std::string field = "alpha_p";
+  /// Frames converted to double at a time are limited to this many bytes (two blocks resident).
+  std::int64_t memoryBudgetBytes = std::int64_t(1536) << 20;
+  int tileFrames = 128;  ///< frames per tile of the parallel loop over tile pairs
+};
+
+struct RecurrenceMatrix {
+  Eigen::MatrixXf R;             ///< N x N, symmetric, unit diagonal, in [0, 1]
+  double normalisation = 0.0;    ///< N_alphaG of Eq. (7): the largest D [m3 field^2 for L2]
+  RecurrenceNorm norm = RecurrenceNorm::L2;
+  std::string field = "alpha_p";
+  int frameBlocks = 1;           ///< memory blocks the frames were split into
+  std::int64_t clampedNegatives = 0;  ///< round-off D < 0 set to 0 (L2 only)
+  double seconds = 0.0;          ///< wall time of the computation
+};
+
+/// D(i, j) (before normalisation) for the series; `blocks` and `clamped` report the blocking and the
+/// negative round-off values clamped to 0.
+Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
+                               std::int64_t memoryBudgetBytes, int tileFrames = 128,
+                               int* blocks = nullptr, std::int64_t* clamped = nullptr);
+
+/// Eq. (6)-(7) from a distance matrix: R = 1 - D / max D (all ones if every D is 0).
+RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D);
+
+RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const RecurrenceOptions& options);
+RecurrenceMatrix computeRecurrenceMatrix(const FieldDatabase& db, const RecurrenceOptions& options = {});
+
+/// Writes R to /recurrence/matrix (float32 [N][N], attributes norm, field, normalisation) of an existing
+/// database file opened read-write; replaces an earlier matrix. The file must not be open elsewhere
+/// (close FieldDatabase objects first). rcfd::RunError on failure.
+void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatrix& matrix);
+/// The stored matrix if the file has one of shape [N][N] with N == expectedFrames.
+std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames);
+
+/// A diagonal of R: lag k [frames] and the mean of R(i, i + k).
+struct RecurrenceLag {
+  int lag = 0;
+  double meanR = 0.0;
+};
+
+struct RecurrenceSummary {
+  double meanOffDiagonal = 0.0;
+  /// Local maxima of the diagonal means over lags 1..N/2, strongest first.
+  std::vector<RecurrenceLag> strongestLags;
+  /// Mean of R(i, i + k) for k = 0..N-1.
+  std::vector<double> diagonalMeans;
+};
+
+RecurrenceSummary summariseRecurrence(const Eigen::MatrixXf& R, int maxLags = 5);
+
+}  // namespace rcfd

@@ -1,0 +1,195 @@
+#include "scene/SceneChecks.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "scene/SchemaExplainer.hpp"
+
+namespace rcfd {
+namespace {
+
+using nlohmann::json;
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+std::string point(const Vec3& p) { return "[" + num(p.x()) + ", " + num(p.y()) + ", " + num(p.z()) + "]"; }
+
+double tanDeg(double deg) { return std::tan(deg * std::numbers::pi / 180.0); }
+
+/// Iterative, so that a document nested thousands deep cannot exhaust the stack.
+void findLimitViolations(const json& document, std::vector<Violation>& out) {
+  struct Item {
+    const json* value;
+    std::string pointer;
+    int depth;
+  };
+  std::vector<Item> pending{{&document, "", 0}};
+  while (!pending.empty()) {
+    Item item = std::move(pending.back());
+    pending.pop_back();
+    const json& value = *item.value;
+    if (value.is_number_float() && !std::isfinite(value.get<double>())) {
+      out.push_back({item.pointer, "number out of range (not a finite double)"});
+    } else if (value.is_number_unsigned() &&
+               value.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
+      out.push_back({item.pointer, describeValue(value) + " is beyond the largest supported integer " +
+                                       std::to_string(std::numeric_limits<std::int64_t>::max())});
+    } else if (value.is_structured() && item.depth >= kMaxDocumentDepth) {
+      out.push_back({item.pointer, "nested deeper than " + std::to_string(kMaxDocumentDepth) +
+                                       " levels; no scene or job key is nested like this"});
+    } else if (value.is_array() && value.size() > kMaxArrayItems) {
+      out.push_back({item.pointer, "array of " + std::to_string(value.size()) + " items is longer than the " +
+                                       std::to_string(kMaxArrayItems) + " allowed"});
+    } else if (value.is_object()) {
+      for (auto it = value.rbegin(); it != value.rend(); ++it) {
+        pending.push_back({&*it, appendPointer(item.pointer, it.key()), item.depth + 1});
+      }
+    } else if (value.is_array()) {
+      for (std::size_t i = value.size(); i-- > 0;) {
+        pending.push_back({&value[i], appendPointer(item.pointer, std::to_string(i)), item.depth + 1});
+      }
+    }
+    if (out.size() >= 20) return;  // enough to fix the document; do not flood
+  }
+}
+
+bool inside(const Vec3& p, const Vec3& lower, const Vec3& upper) {
+  return (p.array() >= lower.array()).all() && (p.array() <= upper.array()).all();
+}
+
+std::string boxText(const Vec3& lower, const Vec3& upper) {
+  return "x in [" + num(lower.x()) + ", " + num(upper.x()) + "], y in [" + num(lower.y()) + ", " +
+         num(upper.y()) + "], z in [" + num(lower.z()) + ", " + num(upper.z()) + "]";
+}
+
+void checkApparatus(const ApparatusSpec& a, std::vector<Violation>& out) {
+  if (a.type != ApparatusSpec::Type::PrismaticSpoutedBed) return;
+  if (a.inlet_width >= a.width) {
+    out.push_back({"/apparatus/inlet_width", num(a.inlet_width) + " m is not < the width " + num(a.width) + " m"});
+    return;
+  }
+  // The V-bottom rises from the slot edge x = inlet_width/2 to the side wall x = width/2.
+  const double vTop = 0.5 * (a.width - a.inlet_width) * tanDeg(a.prism_angle_deg);
+  if (vTop >= a.height) {
+    out.push_back({"/apparatus/height", num(a.height) + " m does not clear the top of the V-bottom at y = " +
+                                            num(vTop) + " m (width, inlet_width, prism_angle_deg)"});
+  }
+  if (!a.draft_plates) return;
+  const auto& p = *a.draft_plates;
+  const double outer = 0.5 * p.gap + p.thickness;
+  if (outer >= 0.5 * a.width) {
+    out.push_back({"/apparatus/draft_plates/gap", "plates' outer faces at x = +-" + num(outer) +
+                                                      " m are not inside the side walls at +-" + num(0.5 * a.width) + " m"});
+    return;
+  }
+  const double wallBelow = std::max(0.0, (outer - 0.5 * a.inlet_width) * tanDeg(a.prism_angle_deg));
+  if (p.elevation <= wallBelow) {
+    out.push_back({"/apparatus/draft_plates/elevation",
+                   num(p.elevation) + " m is not above the V-bottom beneath the plates' outer faces (x = +-" +
+                       num(outer) + " m, wall at y = " + num(wallBelow) + " m): the plates would cut into the wall"});
+  }
+  if (p.elevation + p.height > a.height) {
+    out.push_back({"/apparatus/draft_plates/height", "plates reach y = " + num(p.elevation + p.height) +
+                                                         " m, above the chamber height " + num(a.height) + " m"});
+  }
+}
+
+}  // namespace
+
+void apparatusBounds(const ApparatusSpec& a, Vec3& lower, Vec3& upper) {
+  if (a.type == ApparatusSpec::Type::Box) {
+    lower = Vec3(-0.5 * a.size.x(), 0.0, 0.0);
+    upper = Vec3(0.5 * a.size.x(), a.size.y(), a.size.z());
+  } else {
+    lower = Vec3(-0.5 * a.width, 0.0, 0.0);
+    upper = Vec3(0.5 * a.width, a.height, a.depth);
+  }
+}
+
+std::vector<Violation> documentLimitViolations(const json& document) {
+  std::vector<Violation> out;
+  findLimitViolations(document, out);
+  return out;
+}
+
+std::vector<Violation> checkSceneSemantics(const Scene& s, const json& document) {
+  std::vector<Violation> out;
+  checkApparatus(s.apparatus, out);
+  Vec3 lower, upper;
+  apparatusBounds(s.apparatus, lower, upper);
+  const Vec3 extent = upper - lower;
+
+  static const char* axes[] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i) {
+    if (s.grid.cell_size[i] >= extent[i]) {
+      out.push_back({"/grid/cell_size", "cell size " + num(s.grid.cell_size[i]) + " m along " + axes[i] +
+                                            " is not smaller than the apparatus extent " + num(extent[i]) + " m"});
+    }
+  }
+  const double parcel = s.dem.coarse_graining * s.particles.diameter;
+  if (parcel >= s.grid.cell_size.minCoeff()) {
+    out.push_back({"/dem/coarse_graining", "parcel diameter coarse_graining * diameter = " + num(parcel) +
+                                               " m is not smaller than the smallest cell edge " +
+                                               num(s.grid.cell_size.minCoeff()) + " m"});
+  }
+
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < s.probes.size(); ++i) {
+    const std::string base = "/probes/" + std::to_string(i);
+    if (!names.insert(s.probes[i].name).second) {
+      out.push_back({base + "/name", "duplicate probe name \"" + s.probes[i].name + "\""});
+    }
+    if (!inside(s.probes[i].position, lower, upper)) {
+      out.push_back({base + "/position", point(s.probes[i].position) + " is outside the apparatus's bounding box " +
+                                             boxText(lower, upper)});
+    }
+  }
+
+  // Spray positions matter only where spraying or the spray zone is used; a box verification case
+  // without them must not fail on the ProCell defaults.
+  const bool sprayUsed = document.contains("spray") || s.hasEffect("spray") || s.hasEffect("residence_time");
+  if (sprayUsed) {
+    const auto& sp = s.spray;
+    if (!inside(sp.nozzle_position, lower, upper)) {
+      out.push_back({"/spray/nozzle_position", point(sp.nozzle_position) +
+                                                   " is outside the apparatus's bounding box " + boxText(lower, upper)});
+    }
+    const auto& zone = sp.spray_zone;
+    if (!inside(zone.apex, lower, upper)) {
+      out.push_back({"/spray/spray_zone/apex", point(zone.apex) + " is outside the apparatus's bounding box " +
+                                                   boxText(lower, upper)});
+    }
+    if (!(zone.y_min < zone.y_max)) {
+      out.push_back({"/spray/spray_zone/y_min", num(zone.y_min) + " is not < y_max = " + num(zone.y_max)});
+    }
+    if (zone.y_min < zone.apex.y()) {
+      out.push_back({"/spray/spray_zone/y_min", num(zone.y_min) + " is below the cone apex at y = " + num(zone.apex.y())});
+    }
+    if (zone.y_max > upper.y()) {
+      out.push_back({"/spray/spray_zone/y_max", num(zone.y_max) + " is above the apparatus top y = " + num(upper.y())});
+    }
+  }
+
+  const auto& path = s.rcfd.path;
+  if (path.min_sequence_fraction > path.max_sequence_fraction) {
+    out.push_back({"/rcfd/path/min_sequence_fraction", num(path.min_sequence_fraction) +
+                                                           " is not <= max_sequence_fraction = " +
+                                                           num(path.max_sequence_fraction)});
+  }
+  if (path.type == "file" && path.file.empty()) {
+    out.push_back({"/rcfd/path/file", "path type \"file\" needs a file name"});
+  }
+  if (!(s.rcfd.dt > 0.0)) out.push_back({"/rcfd/dt", num(s.rcfd.dt) + " is not > 0"});
+  return out;
+}
+
+}  // namespace rcfd

@@ -1,0 +1,175 @@
+// deposition: per step each parcel loses the fraction eta (Eq. 11-14) of its droplets into its cell.
+// alpha_P in Eq. (11) is the tracers' own volume fraction, so deposited droplets always have tracers to
+// go to. Droplets are discrete: the droplets stripped in a cell are handed out whole, each to a tracer of
+// that cell drawn at random (a fraction of a droplet waits in the cell for the next step), and a tracer
+// collects 1 / (particles per tracer) droplets per real particle for each. With one tracer per particle,
+// as in the paper, a well-mixed bed thus collects Poisson-distributed droplet counts, as real particles
+// do. Parcels with fewer than one droplet left are removed (N_D,min = 1, the paper).
+//
+// Determinism: per-parcel efficiencies run in parallel; the books, the per-cell carry and the random
+// hand-out run in parcel, cell and tracer order with counter-based random numbers keyed by (cell, step).
+#include <cmath>
+#include <memory>
+
+#include "spray/DepositionEfficiency.hpp"
+#include "spray/SprayState.hpp"
+#include "tracers/CounterRng.hpp"
+#include "tracers/TracerEffect.hpp"
+
+namespace rcfd {
+namespace {
+
+constexpr double kMinDropletsPerParcel = 1.0;  ///< N_D,min of the paper
+
+class DepositionEffect final : public TracerEffect {
+ public:
+  explicit DepositionEffect(TracerContext& ctx)
+      : model_(DepositionModelRegistry::create(ctx.scene.spray.deposition_model)), state_(ctx.spray) {
+    constants_.particleDiameter = ctx.scene.particles.diameter;
+    constants_.dropletDiameter = ctx.scene.spray.droplet_diameter;
+    constants_.dropletDensity = ctx.scene.spray.droplet_density;
+    constants_.gasDensity = ctx.scene.gas.density;
+    constants_.gasViscosity = ctx.scene.gas.kinematic_viscosity;
+    state_->cellDeposit.assign(std::size_t(ctx.grid.cellCount()), 0.0);
+    state_->cellPending.assign(std::size_t(ctx.grid.cellCount()), 0.0);
+    state_->tracerDroplets.assign(ctx.cloud.size(), 0.0);
+    due_.assign(std::size_t(ctx.grid.cellCount()), 0);
+  }
+
+  std::size_t allocatedBytes() const override {
+    return (state_->cellDeposit.capacity() + state_->cellPending.capacity() + state_->tracerDroplets.capacity()) *
+               sizeof(double) +
+           due_.capacity() * sizeof(std::int32_t);
+  }
+
+  void afterMove(TracerContext& ctx) override {
+    stripParcels(ctx);
+    handOut(ctx);
+  }
+
+  void saveState(h5::File& f, const std::string& g) const override {
+    f.write(g + "/tracer_droplets", state_->tracerDroplets);
+    f.write(g + "/cell_pending", state_->cellPending);
+    f.write(g + "/assigned", std::vector<double>{state_->assigned});
+  }
+  void loadState(const h5::File& f, const std::string& g) override {
+    state_->tracerDroplets = f.readDoubles(g + "/tracer_droplets");
+    state_->cellPending = f.readDoubles(g + "/cell_pending");
+    state_->assigned = f.readDoubles(g + "/assigned").at(0);
+  }
+
+ private:
+  void stripParcels(TracerContext& ctx) {
+    auto& s = *state_;
+    auto& pc = s.parcels;
+    const std::int64_t n = std::int64_t(pc.size());
+    s.parcelDeposit.assign(std::size_t(n), 0.0);
+    s.parcelCell.assign(std::size_t(n), 0);
+    const FrameSampler sampler = ctx.sampler();
+#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
+    for (std::int64_t j = 0; j < n; ++j) {
+      const Eigen::Vector3d p = pc.position(std::size_t(j));
+      const auto cell = std::int32_t(ctx.grid.flatIndexOf(p));
+      s.parcelCell[std::size_t(j)] = cell;
+      const DepositionInput in{ctx.tracerAlpha[std::size_t(cell)],
+                               (sampler.velocity(p, true) - sampler.velocity(p, false)).norm(), ctx.dt};
+      s.parcelDeposit[std::size_t(j)] = pc.droplets[std::size_t(j)] * model_->efficiency(in, constants_);
+    }
+    std::fill(s.cellDeposit.begin(), s.cellDeposit.end(), 0.0);
+    touched_.clear();
+    std::size_t keep = 0;
+    for (std::size_t j = 0; j < std::size_t(n); ++j) {
+      const double dep = s.parcelDeposit[j];
+      const auto c = std::size_t(s.parcelCell[j]);
+      if (dep > 0.0) {
+        if (s.cellDeposit[c] == 0.0) touched_.push_back(std::int32_t(c));
+        s.cellDeposit[c] += dep;
+        s.balance.deposited += dep;
+      }
+      const double left = pc.droplets[j] - dep;
+      if (left < kMinDropletsPerParcel) {
+        s.balance.residual += left;
+        continue;
+      }
+      pc.x[keep] = pc.x[j], pc.y[keep] = pc.y[j], pc.z[keep] = pc.z[j];
+      pc.droplets[keep] = left, pc.id[keep] = pc.id[j];
+      ++keep;
+    }
+    pc.x.resize(keep), pc.y.resize(keep), pc.z.resize(keep), pc.droplets.resize(keep), pc.id.resize(keep);
+    if (!pendingCellsKnown_) {  // first step of a run or of a resume: find cells keeping a fraction
+      for (std::size_t c = 0; c < s.cellPending.size(); ++c) {
+        if (s.cellPending[c] > 0.0) touched_.push_back(std::int32_t(c));
+      }
+      pendingCellsKnown_ = true;
+    }
+    touched_.insert(touched_.end(), waiting_.begin(), waiting_.end());
+    std::sort(touched_.begin(), touched_.end());
+    touched_.erase(std::unique(touched_.begin(), touched_.end()), touched_.end());
+  }
+
+  void handOut(TracerContext& ctx) {
+    auto& s = *state_;
+    // Whole droplets due per touched cell; the fraction waits.
+    std::int64_t dueTotal = 0;
+    for (const std::int32_t c : touched_) {
+      const double total = s.cellPending[std::size_t(c)] + s.cellDeposit[std::size_t(c)];
+      const double whole = ctx.tracerCount[std::size_t(c)] > 0 ? std::floor(total) : 0.0;
+      due_[std::size_t(c)] = std::int32_t(whole);
+      s.cellPending[std::size_t(c)] = total - whole;
+      dueTotal += std::int64_t(whole);
+    }
+    waiting_.clear();
+    for (const std::int32_t c : touched_) {
+      if (s.cellPending[std::size_t(c)] > 0.0) waiting_.push_back(c);
+    }
+    if (dueTotal == 0) return;
+    // Tracers of the cells with droplets due, in tracer order.
+    members_.clear();
+    memberCell_.clear();
+    const std::int64_t n = std::int64_t(ctx.cloud.size());
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::int32_t c = ctx.tracerCell[std::size_t(i)];
+      if (due_[std::size_t(c)] > 0) {
+        members_.push_back(std::int32_t(i));
+        memberCell_.push_back(c);
+      }
+    }
+    // Group by cell (stable: tracer order within a cell) and hand out.
+    std::vector<std::size_t> order(members_.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return memberCell_[a] < memberCell_[b]; });
+    const double perParticle = ctx.cloud.particlesPerTracer > 0.0 ? 1.0 / ctx.cloud.particlesPerTracer : 0.0;
+    for (std::size_t start = 0; start < order.size();) {
+      const std::int32_t c = memberCell_[order[start]];
+      std::size_t end = start;
+      while (end < order.size() && memberCell_[order[end]] == c) ++end;
+      const std::uint64_t k = end - start;
+      CounterRng rng(ctx.seed, RngPurpose::Deposition, std::uint64_t(c), std::uint64_t(ctx.step));
+      for (std::int32_t d = 0; d < due_[std::size_t(c)]; ++d) {
+        const std::size_t pick = start + std::size_t(rng.uniform() * double(k));
+        s.tracerDroplets[std::size_t(members_[order[std::min(pick, end - 1)]])] += perParticle;
+      }
+      s.assigned += due_[std::size_t(c)];
+      due_[std::size_t(c)] = 0;
+      start = end;
+    }
+  }
+
+  std::unique_ptr<DepositionModel> model_;
+  std::shared_ptr<SprayState> state_;
+  DepositionConstants constants_;
+  std::vector<std::int32_t> due_;       ///< whole droplets due per cell this step
+  std::vector<std::int32_t> touched_;   ///< cells with new or pending droplets this step
+  std::vector<std::int32_t> waiting_;   ///< cells keeping a fraction of a droplet
+  std::vector<std::int32_t> members_, memberCell_;
+  bool pendingCellsKnown_ = false;
+};
+
+const bool registered = TracerEffectRegistry::add(
+    "deposition", {"spray", "tracer_volume_fraction"}, 51,
+    "Eq. (11)-(14): droplets deposit on the tracers of the parcel's cell (spray.deposition_model)",
+    [](TracerContext& c) { return std::make_unique<DepositionEffect>(c); });
+
+}  // namespace
+}  // namespace rcfd

@@ -1,0 +1,57 @@
+#pragma once
+/// \file SprayState.hpp
+/// Droplet parcels (structure of arrays) and the spray's books, shared by the spray-stage effects.
+/// Droplet numbers are double: a parcel of ~25 droplets loses a fraction eta per step, and the mass
+/// balance injected = deposited + airborne + overspray + residual must close to round-off.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace rcfd {
+
+struct ParcelCloud {
+  std::vector<double> x, y, z;   ///< position [m]
+  std::vector<double> droplets;  ///< droplets carried [-]
+  std::vector<std::int64_t> id;  ///< injection index (stable across compaction)
+
+  std::size_t size() const { return x.size(); }
+  Eigen::Vector3d position(std::size_t i) const { return {x[i], y[i], z[i]}; }
+  void push(const Eigen::Vector3d& p, double n, std::int64_t index) {
+    x.push_back(p.x()), y.push_back(p.y()), z.push_back(p.z()), droplets.push_back(n), id.push_back(index);
+  }
+};
+
+/// Where the injected droplets are, in droplets (multiply by dropletMass for kg).
+struct SprayBalance {
+  double injected = 0.0;
+  double deposited = 0.0;        ///< on tracers (particles)
+  double oversprayWall = 0.0;    ///< parcels that reached a wall, plate or the inlet
+  double oversprayOutlet = 0.0;  ///< parcels that left through the outlet
+  double residual = 0.0;         ///< parcels removed with fewer than one droplet left
+};
+
+struct SprayState {
+  ParcelCloud parcels;
+  SprayBalance balance;
+  std::int64_t injectedParcels = 0;
+  double dropletMass = 0.0;         ///< rho_D pi d_D^3 / 6 [kg]
+  double dropletsPerParcel = 0.0;   ///< N_D at injection [-]
+
+  // Allocated by `deposition`:
+  std::vector<double> cellDeposit;      ///< droplets stripped from parcels per cell in the current step
+  std::vector<double> cellPending;      ///< stripped droplets not yet handed to a tracer (< 1 per cell)
+  double assigned = 0.0;                ///< droplets handed to tracers (whole droplets)
+  std::vector<double> tracerDroplets;   ///< droplets collected per real particle, per tracer
+  std::vector<double> parcelDeposit;    ///< scratch: droplets each parcel deposits this step
+  std::vector<std::int32_t> parcelCell; ///< scratch: each parcel's cell this step
+
+  double airborne() const {
+    double sum = 0.0;
+    for (double n : parcels.droplets) sum += n;
+    return sum;
+  }
+};
+
+}  // namespace rcfd
