@@ -195,6 +195,7 @@ int main(int argc, char** argv) {
   download->add_option("NAME", name, "database.h5, result.h5, summary.json, solver.log or NAME.svg")
       ->required();
   download->add_option("-o,--output", output, "output file (default: NAME)");
+  auto* health = app.add_subcommand("health", "check that the server answers (no token needed)");
   auto* upload = app.add_subcommand("upload", "upload a field database (HDF5, docs/formats.md)");
   upload->add_option("DB", file, "database file")->required()->check(CLI::ExistingFile);
 
@@ -274,6 +275,12 @@ int main(int argc, char** argv) {
       auto res = client.download("/v1/jobs/" + urlEncode(id) + "/artifacts/" + urlEncode(name), output);
       if (!res.ok()) fail(res, "download " + name + " of job " + id);
       std::cerr << "wrote " << output << "\n";
+      return kOk;
+    }
+    if (health->parsed()) {
+      auto res = client.get("/v1/health");
+      if (!res.ok()) fail(res, "health");
+      std::cout << parseJson(res).dump() << "\n";
       return kOk;
     }
     if (upload->parsed()) {
