@@ -155,13 +155,14 @@ void WorkerPool::schedulerLoop() {
         store_.transition(job.id, state::running, state::queued, "server shutting down");
         return;
       }
-      threads_.emplace(job.id, std::thread(&WorkerPool::runJob, this, job));
+      const std::uint64_t run = ++runs_;
+      threads_.emplace(run, std::thread(&WorkerPool::runJob, this, job, run));
       --freeSlots;
     }
   }
 }
 
-void WorkerPool::runJob(JobRecord job) {
+void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
   namespace fs = std::filesystem;
   const fs::path dir = config_.jobDir(job.id);
   const fs::path log = dir / "solver.log";
@@ -281,7 +282,7 @@ void WorkerPool::runJob(JobRecord job) {
   }
   {
     std::lock_guard lock(mutex_);
-    finished_.push_back(job.id);
+    finished_.push_back(run);
     pending_ = true;
   }
   wake_.notify_all();
@@ -347,7 +348,7 @@ void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::stri
 }
 
 void WorkerPool::shutdown() {
-  std::map<std::string, std::thread> threads;
+  std::map<std::uint64_t, std::thread> threads;
   {
     std::lock_guard lock(mutex_);
     if (stopping_ && !scheduler_.joinable()) return;

@@ -43,7 +43,7 @@ class WorkerPool {
 
  private:
   void schedulerLoop();
-  void runJob(JobRecord job);
+  void runJob(JobRecord job, std::uint64_t run);
   void finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail);
   bool isRunnable(JobRecord& job);
 
@@ -54,8 +54,9 @@ class WorkerPool {
   bool stopping_ = false;
   bool pending_ = false;
   std::map<std::string, pid_t> children_;
-  std::map<std::string, std::thread> threads_;
-  std::vector<std::string> finished_;
+  std::map<std::uint64_t, std::thread> threads_;  // by run number (a re-queued job runs again)
+  std::vector<std::uint64_t> finished_;
+  std::uint64_t runs_ = 0;
   std::thread scheduler_;
 };
 

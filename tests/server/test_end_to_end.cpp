@@ -169,6 +169,14 @@ std::vector<pid_t> childrenOf(pid_t parent) {
   return out;
 }
 
+/// True while `pid` exists and is not a zombie (an orphan's zombie may wait for a non-reaping init).
+bool processRunning(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), {});
+  const auto close = text.rfind(')');
+  return close != std::string::npos && close + 2 < text.size() && text[close + 2] != 'Z';
+}
+
 class EndToEnd : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -277,6 +285,7 @@ TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
 
 TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   std::string db, interrupted;
+  pid_t solver = -1;
   {
     auto server = start(1);
     db = upload(*server);
@@ -286,14 +295,16 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
     });
     ASSERT_EQ(running.at("state"), "RUNNING") << running.dump(2);
     ASSERT_LT(running.at("progress").at("fraction").get<double>(), 1.0);
+    const auto solvers = childrenOf(server->pid());
+    ASSERT_EQ(solvers.size(), 1u);
+    solver = solvers[0];
     server->stop(SIGKILL);  // the solver gets SIGTERM from the kernel (PDEATHSIG) and checkpoints
   }
-  // Wait for the orphaned solver to write its checkpoint and exit before restarting.
-  const auto checkpoint = tmp_->path() / "data" / "jobs" / interrupted / "checkpoint.h5";
-  for (int i = 0; i < 200 && !std::filesystem::exists(checkpoint); ++i)
+  // The orphaned solver writes its checkpoint and exits; only then may a new server take the job.
+  for (int i = 0; i < 400 && processRunning(solver); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  ASSERT_TRUE(std::filesystem::exists(checkpoint));
+  ASSERT_FALSE(processRunning(solver)) << "the solver did not stop after the server died";
+  ASSERT_TRUE(std::filesystem::exists(tmp_->path() / "data" / "jobs" / interrupted / "checkpoint.h5"));
 
   auto server = start(1);
   const auto resumed = pollJob(*server, interrupted, isFinal, std::chrono::seconds(90));
