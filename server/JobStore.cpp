@@ -93,11 +93,28 @@ CREATE TABLE databases (
 /// A prepared statement that finalizes itself.
 class Statement {
  public:
-  Statement(sqlite3* db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK)
+  using Cache = std::map<std::string, sqlite3_stmt*>;
+  /// With a cache, the statement is prepared once per connection and only reset after use.
+  Statement(sqlite3* db, const std::string& sql, Cache* cache = nullptr) : db_(db), cached_(cache) {
+    if (cache) {
+      if (auto it = cache->find(sql); it != cache->end()) {
+        stmt_ = it->second;
+        return;
+      }
+    }
+    if (sqlite3_prepare_v3(db, sql.c_str(), -1, cache ? SQLITE_PREPARE_PERSISTENT : 0, &stmt_,
+                           nullptr) != SQLITE_OK)
       throw std::runtime_error(std::string("sqlite prepare: ") + sqlite3_errmsg(db));
+    if (cache) cache->emplace(sql, stmt_);
   }
-  ~Statement() { sqlite3_finalize(stmt_); }
+  ~Statement() {
+    if (cached_) {
+      sqlite3_reset(stmt_);
+      sqlite3_clear_bindings(stmt_);
+    } else {
+      sqlite3_finalize(stmt_);
+    }
+  }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
 
@@ -145,6 +162,7 @@ class Statement {
 
  private:
   sqlite3* db_;
+  Cache* cached_ = nullptr;
   sqlite3_stmt* stmt_ = nullptr;
 };
 
@@ -202,7 +220,10 @@ JobStore::JobStore(const std::string& path) {
   migrate();
 }
 
-JobStore::~JobStore() { sqlite3_close(db_); }
+JobStore::~JobStore() {
+  for (auto& [sql, stmt] : statements_) sqlite3_finalize(stmt);
+  sqlite3_close(db_);
+}
 
 void JobStore::exec(const char* sql) {
   char* message = nullptr;
@@ -244,7 +265,7 @@ void JobStore::migrate() {
 
 int JobStore::schemaVersion() {
   std::lock_guard lock(mutex_);
-  Statement s(db_, "SELECT version FROM schema_version");
+  Statement s(db_, "SELECT version FROM schema_version", &statements_);
   s.step();
   return static_cast<int>(s.integer(0));
 }
@@ -290,7 +311,7 @@ JobStore::InsertResult JobStore::insertJob(const JobRecord& job) {
   insert.bindOrNull(5, job.idempotencyKey).bind(6, job.bodyHash).bindOrNull(7, job.databaseRef);
   insert.bind(8, now).run();
   insertEvent(db_, job.id, {}, state::queued, "submitted", now);
-  Statement read(db_, (std::string("SELECT ") + kJobColumns + " FROM jobs WHERE id = ?1").c_str());
+  Statement read(db_, std::string("SELECT ") + kJobColumns + " FROM jobs WHERE id = ?1", &statements_);
   read.bind(1, job.id).step();
   JobRecord created = readJob(&read);
   tx.commit();
@@ -299,7 +320,7 @@ JobStore::InsertResult JobStore::insertJob(const JobRecord& job) {
 
 std::optional<JobRecord> JobStore::job(const std::string& id) {
   std::lock_guard lock(mutex_);
-  Statement s(db_, (std::string("SELECT ") + kJobColumns + " FROM jobs WHERE id = ?1").c_str());
+  Statement s(db_, std::string("SELECT ") + kJobColumns + " FROM jobs WHERE id = ?1", &statements_);
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
   return readJob(&s);
@@ -463,7 +484,7 @@ std::vector<std::pair<std::string, std::int64_t>> JobStore::countByState() {
                         state::cancelling, state::cancelled})
     out.emplace_back(s, 0);
   std::lock_guard lock(mutex_);
-  Statement s(db_, "SELECT state, COUNT(*) FROM jobs GROUP BY state");
+  Statement s(db_, "SELECT state, COUNT(*) FROM jobs GROUP BY state", &statements_);
   while (s.step())
     for (auto& [name, n] : out)
       if (name == s.text(0)) n = s.integer(1);

@@ -6,6 +6,7 @@
 /// Thread-safe: one connection guarded by a mutex (every statement is short).
 
 #include <cstdint>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -13,6 +14,7 @@
 #include <vector>
 
 struct sqlite3;
+struct sqlite3_stmt;
 
 namespace rcfd::server {
 
@@ -126,6 +128,7 @@ class JobStore {
 
   std::mutex mutex_;
   sqlite3* db_ = nullptr;
+  std::map<std::string, sqlite3_stmt*> statements_;  // prepared once, reused (under mutex_)
 };
 
 /// Current UTC time as RFC 3339 with milliseconds, e.g. 2026-11-22T02:40:00.123Z.
