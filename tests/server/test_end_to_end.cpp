@@ -20,6 +20,7 @@ using namespace rcfd::test;
 namespace {
 
 constexpr int kFrames = 24;
+constexpr long kTracers = 200;
 
 /// examples/quick.json with fewer tracers, so a job takes a second or two.
 nlohmann::json smallScene(long tracers) {
@@ -183,7 +184,7 @@ class EndToEnd : public ::testing::Test {
     if (!std::filesystem::exists(binaryDir() / "rcfd-solve"))
       GTEST_SKIP() << "build rcfd-solve first";
     tmp_ = std::make_unique<TempDir>();
-    scene_ = smallScene(400);
+    scene_ = smallScene(kTracers);
     writeDatabase(scene_, tmp_->path() / "db.h5");
   }
   std::unique_ptr<ServerProcess> start(int workers) {
@@ -214,7 +215,7 @@ TEST_F(EndToEnd, UploadSprayCoverageCsvAndH5EqualResultH5) {
   auto server = start(1);
   const std::string db = upload(*server);
   ASSERT_EQ(db.size(), 32u);
-  std::ofstream(tmp_->path() / "spray.json") << sprayJob(db, 0.5).dump(2);
+  std::ofstream(tmp_->path() / "spray.json") << sprayJob(db, 0.25).dump(2);
   const auto submitted = client(*server, {"submit", (tmp_->path() / "spray.json").string(), "--wait",
                                           "--interval", "0.2"});
   ASSERT_EQ(submitted.code, 0) << submitted.err << server->stderrText();
@@ -242,7 +243,7 @@ TEST_F(EndToEnd, UploadSprayCoverageCsvAndH5EqualResultH5) {
   EXPECT_EQ(h5.counts, reference.counts);
   double tracers = 0;
   for (double c : reference.counts) tracers += c;
-  EXPECT_EQ(tracers, 400.0);  // every tracer is in one bin
+  EXPECT_EQ(tracers, double(kTracers));  // every tracer is in one bin
 
   // Merged bins keep the total; the artifacts list names what the job wrote.
   if (reference.counts.size() % 2 == 0) {
@@ -261,7 +262,7 @@ TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
   auto server = start(2);
   const std::string db = upload(*server);
   const std::string victim = submit(*server, sprayJob(db, 1000.0, 1));  // far too long to finish
-  const std::string other = submit(*server, sprayJob(db, 0.3, 2));
+  const std::string other = submit(*server, sprayJob(db, 0.2, 2));
   const auto running = pollJob(*server, victim, [](const nlohmann::json& j) {
     return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0;
   });
@@ -289,7 +290,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   {
     auto server = start(1);
     db = upload(*server);
-    interrupted = submit(*server, sprayJob(db, 2.0, 5));
+    interrupted = submit(*server, sprayJob(db, 1.0, 5));
     const auto running = pollJob(*server, interrupted, [](const nlohmann::json& j) {
       return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0.1;
     });
@@ -310,7 +311,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   const auto resumed = pollJob(*server, interrupted, isFinal, std::chrono::seconds(90));
   ASSERT_EQ(resumed.at("state"), "SUCCEEDED") << resumed.dump(2);
   EXPECT_EQ(resumed.at("attempt"), 2);
-  const std::string reference = submit(*server, sprayJob(db, 2.0, 5));
+  const std::string reference = submit(*server, sprayJob(db, 1.0, 5));
   ASSERT_EQ(pollJob(*server, reference, isFinal, std::chrono::seconds(90)).at("state"), "SUCCEEDED");
   const auto a = server->get("/v1/jobs/" + interrupted + "/result").json();
   const auto b = server->get("/v1/jobs/" + reference + "/result").json();
