@@ -44,15 +44,15 @@ void ProgressView::update(const nlohmann::json& job) {
   if (line == last_) return;
   last_ = line;
   if (terminal_) {
-    std::cout << "\r\033[K" << line << std::flush;
+    std::cerr << "\r\033[K" << line << std::flush;
     drawn_ = true;
   } else {
-    std::cout << line << std::endl;
+    std::cerr << line << std::endl;
   }
 }
 
 void ProgressView::finish() {
-  if (terminal_ && drawn_) std::cout << "\n";
+  if (terminal_ && drawn_) std::cerr << "\n";
   drawn_ = false;
 }
 

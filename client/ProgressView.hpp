@@ -1,7 +1,7 @@
 #pragma once
 /// \file ProgressView.hpp
-/// Shows a job's progress while `rcfd wait` polls: a one-line bar with ETA redrawn in place on a
-/// terminal, plain lines (one per change) when stdout is a file or pipe.
+/// Shows a job's progress on stderr while `rcfd wait` polls: a one-line bar with ETA redrawn in place on a
+/// terminal, plain lines (one per change) when stderr is a file or pipe.
 
 #include <nlohmann/json.hpp>
 #include <string>

@@ -118,7 +118,7 @@ void printStatus(const json& job) {
 
 /// Polls until the job is final; 0 if it SUCCEEDED.
 int waitFor(HttpClient& client, const std::string& id, double intervalSeconds) {
-  ProgressView view(::isatty(STDOUT_FILENO) != 0);
+  ProgressView view(::isatty(STDERR_FILENO) != 0);  // progress on stderr: stdout stays the job id
   for (;;) {
     auto res = client.get("/v1/jobs/" + id);
     if (!res.ok()) fail(res, "status of job " + id);

@@ -220,7 +220,8 @@ TEST_F(EndToEnd, UploadSprayCoverageCsvAndH5EqualResultH5) {
                                           "--interval", "0.2"});
   ASSERT_EQ(submitted.code, 0) << submitted.err << server->stderrText();
   const std::string id = submitted.out.substr(0, submitted.out.find('\n'));
-  EXPECT_NE(submitted.out.find("SUCCEEDED"), std::string::npos) << submitted.out;
+  EXPECT_NE(submitted.err.find("SUCCEEDED"), std::string::npos) << submitted.err;
+  EXPECT_EQ(submitted.out, id + "\n");  // stdout is only the id, so scripts can capture it
 
   const auto job = server->get("/v1/jobs/" + id).json();
   ASSERT_EQ(job.at("state"), "SUCCEEDED") << job.dump(2);
@@ -290,7 +291,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   {
     auto server = start(1);
     db = upload(*server);
-    interrupted = submit(*server, sprayJob(db, 1.0, 5));
+    interrupted = submit(*server, sprayJob(db, 0.6, 5));
     const auto running = pollJob(*server, interrupted, [](const nlohmann::json& j) {
       return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0.1;
     });
@@ -311,7 +312,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   const auto resumed = pollJob(*server, interrupted, isFinal, std::chrono::seconds(90));
   ASSERT_EQ(resumed.at("state"), "SUCCEEDED") << resumed.dump(2);
   EXPECT_EQ(resumed.at("attempt"), 2);
-  const std::string reference = submit(*server, sprayJob(db, 1.0, 5));
+  const std::string reference = submit(*server, sprayJob(db, 0.6, 5));
   ASSERT_EQ(pollJob(*server, reference, isFinal, std::chrono::seconds(90)).at("state"), "SUCCEEDED");
   const auto a = server->get("/v1/jobs/" + interrupted + "/result").json();
   const auto b = server->get("/v1/jobs/" + reference + "/result").json();
@@ -321,6 +322,31 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   const auto events = server->get("/v1/jobs/" + interrupted + "/events").json().at("events");
   bool requeued = false;
   for (const auto& e : events) requeued = requeued || (e.at("from") == "RUNNING" && e.at("to") == "QUEUED");
+  EXPECT_TRUE(requeued) << events.dump(2);
+}
+
+TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
+  std::string id;
+  {
+    auto server = start(1);
+    const std::string db = upload(*server);
+    id = submit(*server, sprayJob(db, 0.6, 4));
+    const auto running = pollJob(*server, id, [](const nlohmann::json& j) {
+      return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0;
+    });
+    ASSERT_EQ(running.at("state"), "RUNNING") << running.dump(2);
+    const int status = server->stop(SIGTERM);  // waits for the solver to checkpoint
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << server->stderrText();
+  }
+  auto server = start(1);
+  const auto done = pollJob(*server, id, isFinal, std::chrono::seconds(90));
+  EXPECT_EQ(done.at("state"), "SUCCEEDED") << done.dump(2);
+  EXPECT_EQ(done.at("attempt"), 2);
+  const auto events = server->get("/v1/jobs/" + id + "/events").json().at("events");
+  bool requeued = false;
+  for (const auto& e : events)
+    requeued = requeued || (e.at("from") == "RUNNING" && e.at("to") == "QUEUED" &&
+                            e.at("reason").get<std::string>().find("shut down") != std::string::npos);
   EXPECT_TRUE(requeued) << events.dump(2);
 }
 
