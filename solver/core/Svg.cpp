@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -147,6 +148,95 @@ void SvgDocument::heatmap(const std::vector<double>& values, int nx, int ny, dou
                "\" height=\"" + num(b - t + 0.3) + "\" fill=\"" + colormap(v).hex() + "\"/>\n";
     }
   }
+}
+
+namespace {
+// A PNG file (RGB, 8 bit) with the image data in stored (uncompressed) deflate blocks: no zlib needed.
+std::string pngStored(const std::vector<unsigned char>& rgb, int width, int height) {
+  auto crc32 = [](const std::string& bytes) {
+    std::uint32_t c = 0xffffffffu;
+    for (unsigned char b : bytes) {
+      c ^= b;
+      for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return c ^ 0xffffffffu;
+  };
+  auto be32 = [](std::string& out, std::uint32_t v) {
+    for (int s = 24; s >= 0; s -= 8) out.push_back(char((v >> s) & 0xff));
+  };
+  auto chunk = [&](std::string& out, const char* type, const std::string& data) {
+    be32(out, std::uint32_t(data.size()));
+    const std::string body = std::string(type, 4) + data;
+    out += body;
+    be32(out, crc32(body));
+  };
+  std::string raw;  // each row: filter byte 0, then RGB
+  for (int y = 0; y < height; ++y) {
+    raw.push_back('\0');
+    raw.append(reinterpret_cast<const char*>(rgb.data()) + std::size_t(y) * width * 3, std::size_t(width) * 3);
+  }
+  std::string z = "\x78\x01";
+  for (std::size_t pos = 0; pos < raw.size() || pos == 0; pos += 65535) {
+    const std::size_t len = std::min<std::size_t>(65535, raw.size() - pos);
+    z.push_back(pos + len >= raw.size() ? '\x01' : '\x00');
+    z.push_back(char(len & 0xff)), z.push_back(char(len >> 8));
+    z.push_back(char(~len & 0xff)), z.push_back(char((~len >> 8) & 0xff));
+    z.append(raw, pos, len);
+    if (raw.empty()) break;
+  }
+  std::uint32_t a = 1, b = 0;  // Adler-32
+  for (unsigned char ch : raw) a = (a + ch) % 65521u, b = (b + a) % 65521u;
+  be32(z, (b << 16) | a);
+  std::string header;
+  be32(header, std::uint32_t(width));
+  be32(header, std::uint32_t(height));
+  header += std::string("\x08\x02\x00\x00\x00", 5);  // 8 bit, RGB, deflate, no filter, no interlace
+  std::string png = "\x89PNG\r\n\x1a\n";
+  chunk(png, "IHDR", header);
+  chunk(png, "IDAT", z);
+  chunk(png, "IEND", "");
+  return png;
+}
+
+std::string base64(const std::string& bytes) {
+  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const std::uint32_t v = (std::uint32_t(std::uint8_t(bytes[i])) << 16) |
+                            (std::uint32_t(std::uint8_t(bytes[i + 1])) << 8) | std::uint8_t(bytes[i + 2]);
+    for (int s = 18; s >= 0; s -= 6) out.push_back(table[(v >> s) & 63]);
+  }
+  if (i < bytes.size()) {
+    std::uint32_t v = std::uint32_t(std::uint8_t(bytes[i])) << 16;
+    if (i + 1 < bytes.size()) v |= std::uint32_t(std::uint8_t(bytes[i + 1])) << 8;
+    out.push_back(table[(v >> 18) & 63]);
+    out.push_back(table[(v >> 12) & 63]);
+    out.push_back(i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=');
+    out.push_back('=');
+  }
+  return out;
+}
+}  // namespace
+
+void SvgDocument::heatmapImage(const std::vector<double>& values, int nx, int ny, double x0, double x1,
+                               double y0, double y1) {
+  std::vector<unsigned char> rgb(std::size_t(nx) * std::size_t(ny) * 3, 255);
+  for (int row = 0; row < ny; ++row) {
+    const int j = ny - 1 - row;  // PNG rows run top to bottom, user y upwards
+    for (int i = 0; i < nx; ++i) {
+      const double v = values[std::size_t(j) * nx + i];
+      if (std::isnan(v)) continue;
+      const Rgb c = colormap(v);
+      unsigned char* p = &rgb[(std::size_t(row) * nx + i) * 3];
+      p[0] = c.r, p[1] = c.g, p[2] = c.b;
+    }
+  }
+  const double left = std::min(px(x0), px(x1)), top = std::min(py(y0), py(y1));
+  body_ += "<image x=\"" + num(left) + "\" y=\"" + num(top) + "\" width=\"" + num(std::abs(px(x1) - px(x0))) +
+           "\" height=\"" + num(std::abs(py(y1) - py(y0))) +
+           "\" preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" href=\"data:image/png;base64," +
+           base64(pngStored(rgb, nx, ny)) + "\"/>\n";
 }
 
 void SvgDocument::axes(const std::string& xlabel, const std::string& ylabel, int xticks, int yticks) {

@@ -47,6 +47,10 @@ class SvgDocument {
   /// NaN cells are left blank.
   void heatmap(const std::vector<double>& values, int nx, int ny, double x0, double x1, double y0,
                double y1);
+  /// Like heatmap(), for large arrays (e.g. a 400 x 400 recurrence plot): the cells are embedded as
+  /// one PNG image (uncompressed, base64), a fraction of the size of one <rect> per cell. NaN: white.
+  void heatmapImage(const std::vector<double>& values, int nx, int ny, double x0, double x1, double y0,
+                    double y1);
   /// Axis box with ticks and labels along the plot area's edges.
   void axes(const std::string& xlabel, const std::string& ylabel, int xticks = 5, int yticks = 5);
 

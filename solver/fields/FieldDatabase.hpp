@@ -65,7 +65,9 @@ class FieldDatabase {
   virtual double dtRec() const = 0;  ///< sampling interval [s]
   virtual int frameCount() const = 0;
   virtual const std::string& sceneJson() const = 0;
-  /// Frame `index` (0 <= index < frameCount()); safe to call from several threads.
+  /// Frame `index` (0 <= index < frameCount()); safe to call from several threads. With a frame cache
+  /// a frame is validated when first read: rcfd::InputError if it holds NaN/Inf (catch it before it
+  /// leaves an OpenMP region); std::out_of_range for a bad index.
   virtual std::shared_ptr<const FieldFrame> frame(int index) const = 0;
   virtual FrameCacheStats cacheStats() const = 0;
   /// Bytes of one frame in memory (FieldFrame::bytes()).

@@ -1,22 +1,36 @@
 #include "fields/FieldValidation.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
 
 namespace rcfd {
 
 namespace {
 std::string str(double v) {
+  if (std::isnan(v)) return "NaN";
+  if (std::isinf(v)) return v > 0 ? "+Inf" : "-Inf";
   std::ostringstream out;
   out.precision(9);
   out << v;
   return out.str();
 }
 
-// First non-finite entry of `values` (flat index), or -1.
+// First non-finite entry of `values` (flat index), or -1. The scan tests the exponent bits (all ones:
+// NaN or Inf) without an early exit so it vectorises; only a bad frame pays for the search.
 std::int64_t firstNonFinite(const std::vector<float>& values) {
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (!std::isfinite(values[i])) return std::int64_t(i);
+  std::uint32_t bad = 0;
+  const float* v = values.data();
+  const std::size_t n = values.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t bits;
+    std::memcpy(&bits, v + i, sizeof bits);
+    bad |= std::uint32_t((bits & 0x7f800000u) == 0x7f800000u);
+  }
+  if (!bad) return -1;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) return std::int64_t(i);
   }
   return -1;
 }

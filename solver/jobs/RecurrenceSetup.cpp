@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <limits>
+
 #include "core/Errors.hpp"
 
 namespace rcfd {
@@ -11,7 +13,8 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
   RecurrenceSetup setup;
   {
     // Peek at the frame count first: the matrix must be stored while no reader holds the file.
-    auto probe = FieldDatabase::open(databasePath, FrameStorage{std::int64_t(1) << 20});
+    // A cache as large as any database reads no frame on open: only the frame count is needed here.
+    auto probe = FieldDatabase::open(databasePath, FrameStorage{std::numeric_limits<std::int64_t>::max()});
     const int n = probe->frameCount();
     probe.reset();
     if (auto stored = loadRecurrenceMatrix(databasePath, n)) {

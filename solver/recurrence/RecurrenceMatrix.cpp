@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <random>
+#include <type_traits>
 
 #include "core/Errors.hpp"
 #include "fields/Hdf5.hpp"
@@ -76,24 +79,40 @@ std::vector<Tile> tiles(int first, int count, int size) {
   return out;
 }
 
-// Fetches frames [first, first + count) into columns, transformed by `store(column, values)`.
+// Fetches frames [first, first + count) into columns, transformed by `store(column, values)`. A frame
+// that fails to load (e.g. NaN found by a cached database) throws after the parallel loop: exceptions
+// must not leave an OpenMP region.
 template <class Store>
 void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
   const std::size_t cells = s.weights.size();
-#pragma omp parallel
+  std::exception_ptr failure;
+  // Small loads stay on one thread: an OpenMP region costs more than it saves when cores are shared.
+#pragma omp parallel if (std::int64_t(count) * std::int64_t(cells) > (1 << 18))
   {
     std::vector<float> buffer(cells);
 #pragma omp for schedule(dynamic, 1)
     for (int f = 0; f < count; ++f) {
-      s.fetch(first + f, buffer.data());
-      store(f, buffer);
+      try {
+        s.fetch(first + f, buffer.data());
+        store(f, buffer);
+      } catch (...) {
+#pragma omp critical(rcfd_recurrence_failure)
+        if (!failure) failure = std::current_exception();
+      }
     }
   }
+  if (failure) std::rethrow_exception(failure);
 }
 
 // Gram form of the L2 distances. Frames are centred on frame 0 (D is unchanged, (a_i - r) - (a_j - r)
 // = a_i - a_j) so n_i + n_j - 2 G_ij cancels less, then scaled by sqrt(V_c): G_ij = sum_c V_c x_i x_j.
+// Scalar = double: one double GEMM per tile pair. Scalar = float: float GEMMs over chunks of
+// `floatChunk` cells, each chunk's partial sums added in double, so rounding grows with the chunk, not
+// with the cell count (docs/performance.md compares both).
+template <class Scalar>
 Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileFrames, std::int64_t* clamped) {
+  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  constexpr Eigen::Index floatChunk = 512;
   const int n = s.frames;
   const Eigen::Index cells = Eigen::Index(s.weights.size());
   std::vector<float> reference(s.weights.size());
@@ -101,43 +120,58 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
   Eigen::VectorXd sqrtW(cells);
   for (Eigen::Index c = 0; c < cells; ++c) sqrtW[c] = std::sqrt(s.weights[std::size_t(c)]);
 
-  auto load = [&](int first, int count, Eigen::MatrixXd& X) {
+  Eigen::VectorXd norms(n);
+  auto load = [&](int first, int count, Matrix& X) {
     X.resize(cells, count);
     loadFrames(s, first, count, [&](int f, const std::vector<float>& v) {
-      double* col = X.col(f).data();
-      for (Eigen::Index c = 0; c < cells; ++c) col[c] = sqrtW[c] * (double(v[std::size_t(c)]) - reference[std::size_t(c)]);
+      Scalar* col = X.col(f).data();
+      double squared = 0.0;
+      for (Eigen::Index c = 0; c < cells; ++c) {
+        const double x = sqrtW[c] * (double(v[std::size_t(c)]) - reference[std::size_t(c)]);
+        col[c] = Scalar(x);
+        squared += double(col[c]) * double(col[c]);  // n_i in double from the stored values
+      }
+      norms[first + f] = squared;
     });
   };
 
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);  // upper triangle filled
-  Eigen::VectorXd norms(n);
   const auto blocks = tiles(0, n, framesPerBlock);
-  Eigen::MatrixXd XP, XQ;
+  Matrix XP, XQ;
   for (std::size_t p = 0; p < blocks.size(); ++p) {
     load(blocks[p].first, blocks[p].count, XP);
-    norms.segment(blocks[p].first, blocks[p].count) = XP.colwise().squaredNorm().transpose();
     for (std::size_t q = p; q < blocks.size(); ++q) {
       if (q != p) load(blocks[q].first, blocks[q].count, XQ);
-      const Eigen::MatrixXd& Y = q == p ? XP : XQ;
+      const Matrix& Y = q == p ? XP : XQ;
       const auto tp = tiles(0, blocks[p].count, tileFrames);
       const auto tq = tiles(0, blocks[q].count, tileFrames);
       std::vector<std::pair<int, int>> pairs;
       for (int a = 0; a < int(tp.size()); ++a)
         for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
-      // Each tile product is one single-threaded GEMM (Eigen does not nest inside omp parallel);
-      // only tiles on or above the diagonal are computed.
-#pragma omp parallel for schedule(dynamic, 1)
+      // Each tile product is single-threaded GEMM (Eigen does not nest inside omp parallel); tiles
+      // are independent, which keeps both cores busy even when other processes share them. Only tiles
+      // on or above the diagonal are computed.
+#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
       for (int k = 0; k < int(pairs.size()); ++k) {
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
-        G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count).noalias() =
-            XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
+        auto target = G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count);
+        if constexpr (std::is_same_v<Scalar, double>) {
+          target.noalias() = XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
+        } else {
+          Eigen::MatrixXf partial(a.count, b.count);
+          for (Eigen::Index c0 = 0; c0 < cells; c0 += floatChunk) {
+            const Eigen::Index len = std::min(floatChunk, cells - c0);
+            partial.noalias() = XP.block(c0, a.first, len, a.count).transpose() * Y.block(c0, b.first, len, b.count);
+            target += partial.cast<double>();
+          }
+        }
       }
     }
   }
   std::int64_t negatives = 0;
   Eigen::MatrixXd& D = G;  // converted in place, upper triangle first
-#pragma omp parallel for schedule(dynamic, 16) reduction(+ : negatives)
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : negatives) if (n > 512)
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       double d = norms[i] + norms[j] - 2.0 * D(i, j);
@@ -185,7 +219,7 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
       std::vector<std::pair<int, int>> pairs;
       for (int a = 0; a < int(tp.size()); ++a)
         for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
       for (int k = 0; k < int(pairs.size()); ++k) {
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
@@ -229,20 +263,26 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
 
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames, int* blocks,
-                               std::int64_t* clamped) {
+                               std::int64_t* clamped, GramPrecision precision) {
   const int n = series.frames;
   if (n < 1 || series.weights.empty()) {
     throw InputError("recurrence", "/frames", "no frames or no open cells to compare");
   }
   tileFrames = std::max(1, tileFrames);
   const std::int64_t bytesPerFrame =
-      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 ? 8 : 4);
-  // Two blocks are resident at a time (rows P and columns Q of the block pair).
-  std::int64_t perBlock = std::max<std::int64_t>(1, memoryBudgetBytes / (2 * bytesPerFrame));
-  int framesPerBlock = int(std::min<std::int64_t>(n, std::max<std::int64_t>(perBlock, 1)));
+      std::int64_t(series.weights.size()) * (norm == RecurrenceNorm::L2 && precision != GramPrecision::FloatChunked ? 8 : 4);
+  // All frames in one block if they fit the budget; otherwise two blocks are resident at a time (rows
+  // P and columns Q of a block pair), each half the budget.
+  const std::int64_t perBlock = bytesPerFrame * n <= memoryBudgetBytes
+                                    ? n
+                                    : std::max<std::int64_t>(1, memoryBudgetBytes / (2 * bytesPerFrame));
+  const int framesPerBlock = int(std::min<std::int64_t>(n, perBlock));
   if (blocks) *blocks = (n + framesPerBlock - 1) / framesPerBlock;
   if (clamped) *clamped = 0;
-  if (norm == RecurrenceNorm::L2) return l2Distances(series, framesPerBlock, tileFrames, clamped);
+  if (norm == RecurrenceNorm::L2) {
+    return precision == GramPrecision::FloatChunked ? l2Distances<float>(series, framesPerBlock, tileFrames, clamped)
+                                                    : l2Distances<double>(series, framesPerBlock, tileFrames, clamped);
+  }
   return directDistances(series, norm, framesPerBlock, tileFrames);
 }
 
@@ -259,17 +299,67 @@ RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D) {
   return m;
 }
 
-RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const RecurrenceOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+namespace {
+
+// Largest |R(i, j) - R_exact(i, j)| over `pairs` seeded random entries and the most distant pair, with
+// R_exact from Eq. (6) summed in double straight from the frames (normalised by m's max D).
+double spotCheck(const ScalarSeries& s, const RecurrenceMatrix& m, int pairs) {
+  const int n = s.frames;
+  std::vector<std::pair<int, int>> entries;
+  Eigen::Index fi = 0, fj = 0;
+  m.R.minCoeff(&fi, &fj);
+  entries.emplace_back(int(fi), int(fj));
+  std::mt19937_64 rng(20240521);
+  for (int k = 0; k < pairs; ++k)
+    entries.emplace_back(int(rng() % std::uint64_t(n)), int(rng() % std::uint64_t(n)));
+  const std::size_t cells = s.weights.size();
+  double worst = 0.0;
+  std::vector<float> a(cells), b(cells);
+  for (const auto& [i, j] : entries) {
+    s.fetch(i, a.data());
+    s.fetch(j, b.data());
+    double d = 0.0;
+    for (std::size_t c = 0; c < cells; ++c) {
+      const double diff = double(a[c]) - double(b[c]);
+      d += s.weights[c] * diff * diff;  // Eq. (6)
+    }
+    const double exact = m.normalisation > 0.0 ? 1.0 - d / m.normalisation : 1.0;
+    worst = std::max(worst, std::abs(exact - double(m.R(i, j))));
+  }
+  return worst;
+}
+
+RecurrenceMatrix computeOnce(const ScalarSeries& series, const RecurrenceOptions& options, GramPrecision gram) {
   int blocks = 1;
   std::int64_t clamped = 0;
   const Eigen::MatrixXd D =
-      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped);
+      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped, gram);
   RecurrenceMatrix m = normaliseDistances(D);
   m.norm = options.norm;
   m.field = options.field;
   m.frameBlocks = blocks;
   m.clampedNegatives = clamped;
+  m.gramUsed = gram;
+  return m;
+}
+
+}  // namespace
+
+RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const RecurrenceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  RecurrenceMatrix m;
+  if (options.norm != RecurrenceNorm::L2 || options.gram != GramPrecision::Auto) {
+    m = computeOnce(series, options, options.gram == GramPrecision::Auto ? GramPrecision::Double : options.gram);
+  } else {
+    m = computeOnce(series, options, GramPrecision::FloatChunked);
+    m.spotCheckError = spotCheck(series, m, options.autoCheckPairs);
+    if (!(m.spotCheckError <= options.autoTolerance)) {
+      const double failedError = m.spotCheckError;
+      m = computeOnce(series, options, GramPrecision::Double);
+      m.spotCheckError = failedError;
+      m.autoFellBack = true;
+    }
+  }
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return m;
 }

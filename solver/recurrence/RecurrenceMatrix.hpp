@@ -4,7 +4,8 @@
 ///   R(i, j) = 1 - D(i, j) / max D,  D(i, j) = sum_c V_c (a_i,c - a_j,c)^2
 /// with V_c the open volume of cell c (fluid fraction x cell volume) and a the compared field
 /// (alpha_P by default: the paper's alpha_G = 1 - alpha_P gives the same differences). The L2 norm is
-/// computed through the Gram matrix, D = n_i + n_j - 2 G_ij with G = X^T W X, in double precision,
+/// computed through the Gram matrix, D = n_i + n_j - 2 G_ij with G = X^T W X, accumulated in double
+/// (GramPrecision),
 /// blocked over frames so only a memory budget's worth of frames is converted at a time. The L1 norm
 /// (sum_c V_c |a_i - a_j|) and the max norm (max_c |a_i - a_j| over open cells) follow
 /// CFDEMcoupling-PFM's absDiffNorm and maxNorm; they have no Gram form and use a blocked direct loop.
@@ -57,12 +58,22 @@ struct ScalarSeries {
 /// The open cells (fluid fraction > 0) of a database and the chosen field on them.
 ScalarSeries scalarSeries(const FieldDatabase& db, const FieldComponent& field);
 
+/// Arithmetic of the L2 Gram matrix. Double: double GEMM (R within ~3e-8 of a naive double loop).
+/// FloatChunked: float GEMMs over chunks of 512 cells, the chunks summed in double (about twice as
+/// fast; R within ~3e-7 at the paper's size). Auto (default): FloatChunked, then a spot check of
+/// autoCheckPairs entries (and the most distant pair) against exact double sums; if any differs by
+/// more than autoTolerance the matrix is recomputed in Double. docs/recurrence.md has the figures.
+enum class GramPrecision { Double, FloatChunked, Auto };
+
 struct RecurrenceOptions {
   RecurrenceNorm norm = RecurrenceNorm::L2;
   std::string field = "alpha_p";
   /// Frames converted to double at a time are limited to this many bytes (two blocks resident).
   std::int64_t memoryBudgetBytes = std::int64_t(1536) << 20;
   int tileFrames = 128;  ///< frames per tile of the parallel loop over tile pairs
+  GramPrecision gram = GramPrecision::Auto;
+  int autoCheckPairs = 64;       ///< Auto: random entries checked against exact double sums
+  double autoTolerance = 3e-7;   ///< Auto: largest accepted |R - R_exact| in the check (target 1e-6)
 };
 
 struct RecurrenceMatrix {
@@ -73,13 +84,17 @@ struct RecurrenceMatrix {
   int frameBlocks = 1;           ///< memory blocks the frames were split into
   std::int64_t clampedNegatives = 0;  ///< round-off D < 0 set to 0 (L2 only)
   double seconds = 0.0;          ///< wall time of the computation
+  GramPrecision gramUsed = GramPrecision::Double;  ///< L2: the arithmetic that produced R
+  double spotCheckError = 0.0;   ///< Auto: largest |R - R_exact| over the checked entries
+  bool autoFellBack = false;     ///< Auto: the float result failed the check; R is the double one
 };
 
 /// D(i, j) (before normalisation) for the series; `blocks` and `clamped` report the blocking and the
 /// negative round-off values clamped to 0.
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames = 128,
-                               int* blocks = nullptr, std::int64_t* clamped = nullptr);
+                               int* blocks = nullptr, std::int64_t* clamped = nullptr,
+                               GramPrecision precision = GramPrecision::Double);
 
 /// Eq. (6)-(7) from a distance matrix: R = 1 - D / max D (all ones if every D is 0).
 RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D);

@@ -27,7 +27,9 @@ struct RecurrencePath {
 
 struct PathStatistics {
   std::int64_t jumps = 0;
-  double meanJumpSimilarity = 0.0;  ///< mean R(i, j) over the jumps' (from, to) states
+  /// Mean R(from, to - 1) over the jumps from frame `from` to frame `to`: the similarity of the state
+  /// left to the state the jump matched (a jump continues at the frame after the matched state).
+  double meanJumpSimilarity = 0.0;
   double meanSequenceLength = 0.0;  ///< [frames]
 };
 

@@ -5,6 +5,11 @@
 /// (gamma_{n+1} - gamma_{n-1}) / (2 dt_rec) on the interior frames 1..N-2 (both averages use those
 /// frames). As in the paper, the mean is not subtracted: <gamma^2> is the mean square, not the
 /// variance. Evaluated at probe points (the cell containing each point) or over every open cell.
+///
+/// Caveat: computed from the frames themselves, central differences cannot see content faster than
+/// the sampling (it aliases), and |gamma_dot| <= 2 max|gamma| / (2 dt) keeps the bound near or above
+/// dt_rec; a bound close to dt_rec means "not resolved". A conclusive check uses a signal sampled
+/// faster than dt_rec (samplingBound() on a CFD-DEM probe series, as in the paper's Fig. 5).
 
 #include <Eigen/Core>
 #include <array>
@@ -46,6 +51,11 @@ struct SamplingReport {
 /// `probes` is empty. rcfd::InputError for an unknown field or a probe outside the grid.
 SamplingReport samplingCriterion(const FieldDatabase& db, const std::string& field = "u_p.y",
                                  const std::vector<SamplingProbe>& probes = {});
+
+/// Eq. (8) for one time series gamma_n sampled every dt [s] (e.g. a CFD-DEM probe signal sampled
+/// faster than the fields): sqrt(<gamma^2>/<gamma_dot^2>) over the interior samples, central
+/// differences; +inf if gamma never changes. rcfd::InputError for fewer than 3 samples or dt <= 0.
+double samplingBound(const std::vector<double>& gamma, double dt);
 
 /// The scene's probes ({"probes": [{"name": ..., "position": [x, y, z]}]}); none if the JSON has no
 /// such list or is not JSON.

@@ -17,20 +17,30 @@ class CoverageEffect final : public TracerEffect {
         f_(singleDropletCoverage(ctx.scene.spray.droplet_diameter, ctx.scene.particles.diameter)),
         bins_(ctx.scene.outputs.coverage_bins) {}
 
-  Distribution distribution() const {
-    std::vector<double> phi(state_->tracerDroplets.size());
-    for (std::size_t i = 0; i < phi.size(); ++i) phi[i] = coverage(state_->tracerDroplets[i], f_);
+  /// Droplets collected per real particle, per tracer (N_coll of Eq. 15).
+  std::vector<double> perParticle(const TracerContext& ctx) const {
+    const double ppt = ctx.cloud.particlesPerTracer;
+    std::vector<double> n(state_->tracerDroplets.size(), 0.0);
+    if (ppt > 0.0) {
+      for (std::size_t i = 0; i < n.size(); ++i) n[i] = state_->tracerDroplets[i] / ppt;
+    }
+    return n;
+  }
+
+  Distribution distribution(const TracerContext& ctx) const {
+    auto phi = perParticle(ctx);
+    for (double& v : phi) v = coverage(v, f_);
     return describe(std::move(phi), bins_, 0.0, 1.0);
   }
 
   void writeResults(const TracerContext& ctx, h5::File& out, nlohmann::json& summary) const override {
-    const auto& droplets = state_->tracerDroplets;
+    const auto droplets = perParticle(ctx);
     std::vector<double> phi(droplets.size());
-    double dropletSum = 0.0;
-    for (std::size_t i = 0; i < phi.size(); ++i) {
-      phi[i] = coverage(droplets[i], f_);
-      dropletSum += droplets[i];
-    }
+    for (std::size_t i = 0; i < phi.size(); ++i) phi[i] = coverage(droplets[i], f_);
+    // Whole droplets are exact in double: the mean per particle is collected / real particles exactly.
+    double collected = 0.0;
+    for (double d : state_->tracerDroplets) collected += d;
+    const double realParticles = ctx.cloud.particlesPerTracer * double(droplets.size());
     out.write("/coverage/per_tracer", phi);
     out.write("/coverage/droplets_per_particle", droplets);
     const Distribution d = describe(phi, bins_, 0.0, 1.0);
@@ -41,12 +51,11 @@ class CoverageEffect final : public TracerEffect {
     summary["coverage"] = {{"mean", d.mean}, {"median", d.median}, {"p10", d.p10}, {"p90", d.p90},
                            {"f", f_},
                            {"histogram", {{"edges", d.edges}, {"counts", d.counts}}}};
-    summary["droplets_per_tracer_mean"] = droplets.empty() ? 0.0 : dropletSum / double(droplets.size());
-    (void)ctx;
+    summary["droplets_per_tracer_mean"] = realParticles > 0.0 ? collected / realParticles : 0.0;
   }
 
   std::vector<std::string> writeFigures(const TracerContext& ctx, const std::string& outDir) const override {
-    const Distribution d = distribution();
+    const Distribution d = distribution(ctx);
     long long peak = 1;
     for (auto c : d.counts) peak = std::max(peak, c);
     const double total = double(std::max<std::size_t>(1, state_->tracerDroplets.size()));

@@ -1,15 +1,17 @@
 // deposition: per step each parcel loses the fraction eta (Eq. 11-14) of its droplets into its cell.
 // alpha_P in Eq. (11) is the tracers' own volume fraction, so deposited droplets always have tracers to
 // go to. Droplets are discrete: the droplets stripped in a cell are handed out whole, each to a tracer of
-// that cell drawn at random (a fraction of a droplet waits in the cell for the next step), and a tracer
-// collects 1 / (particles per tracer) droplets per real particle for each. With one tracer per particle,
+// that cell drawn at random (a fraction of a droplet waits in the cell for the next step); a tracer's
+// droplets per real particle are its droplets / (particles per tracer). With one tracer per particle,
 // as in the paper, a well-mixed bed thus collects Poisson-distributed droplet counts, as real particles
 // do. Parcels with fewer than one droplet left are removed (N_D,min = 1, the paper).
 //
 // Determinism: per-parcel efficiencies run in parallel; the books, the per-cell carry and the random
 // hand-out run in parcel, cell and tracer order with counter-based random numbers keyed by (cell, step).
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <random>
 
 #include "spray/DepositionEfficiency.hpp"
 #include "spray/SprayState.hpp"
@@ -139,22 +141,54 @@ class DepositionEffect final : public TracerEffect {
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return memberCell_[a] < memberCell_[b]; });
-    const double perParticle = ctx.cloud.particlesPerTracer > 0.0 ? 1.0 / ctx.cloud.particlesPerTracer : 0.0;
     for (std::size_t start = 0; start < order.size();) {
       const std::int32_t c = memberCell_[order[start]];
       std::size_t end = start;
       while (end < order.size() && memberCell_[order[end]] == c) ++end;
-      const std::uint64_t k = end - start;
       CounterRng rng(ctx.seed, RngPurpose::Deposition, std::uint64_t(c), std::uint64_t(ctx.step));
-      for (std::int32_t d = 0; d < due_[std::size_t(c)]; ++d) {
-        const std::size_t pick = start + std::size_t(rng.uniform() * double(k));
-        s.tracerDroplets[std::size_t(members_[order[std::min(pick, end - 1)]])] += perParticle;
-      }
-      s.assigned += due_[std::size_t(c)];
+      distribute(rng, std::int64_t(due_[std::size_t(c)]), start, end, order, s.tracerDroplets);
+      s.assigned += double(due_[std::size_t(c)]);
       due_[std::size_t(c)] = 0;
       start = end;
     }
   }
+
+  /// Hands `droplets` whole droplets to the tracers order[start, end) with equal probability each: a
+  /// multinomial draw. Few droplets: one uniform pick per droplet; many: sequential binomials, so the
+  /// cost is bounded by the number of tracers, not of droplets (compressed-time tests deposit 1e7 per
+  /// step).
+  void distribute(CounterRng& rng, std::int64_t droplets, std::size_t start, std::size_t end,
+                  const std::vector<std::size_t>& order, std::vector<double>& collected) const {
+    const std::size_t k = end - start;
+    if (droplets <= std::int64_t(k)) {
+      for (std::int64_t d = 0; d < droplets; ++d) {
+        const std::size_t pick = std::min(end - 1, start + std::size_t(rng.uniform() * double(k)));
+        collected[std::size_t(members_[order[pick]])] += 1.0;
+      }
+      return;
+    }
+    std::int64_t left = droplets;
+    for (std::size_t m = start; m < end && left > 0; ++m) {
+      const std::size_t remaining = end - m;
+      std::int64_t take = left;
+      if (remaining > 1) {
+        CounterUrbg urbg{&rng};
+        std::binomial_distribution<std::int64_t> binomial(left, 1.0 / double(remaining));
+        take = binomial(urbg);
+      }
+      collected[std::size_t(members_[order[m]])] += double(take);
+      left -= take;
+    }
+  }
+
+  /// CounterRng as a UniformRandomBitGenerator for the standard distributions.
+  struct CounterUrbg {
+    using result_type = std::uint64_t;
+    CounterRng* rng;
+    static constexpr result_type min() { return 0; }
+    static constexpr result_type max() { return ~result_type(0); }
+    result_type operator()() { return rng->nextU64(); }
+  };
 
   std::unique_ptr<DepositionModel> model_;
   std::shared_ptr<SprayState> state_;

@@ -109,7 +109,6 @@ class SprayEffect final : public TracerEffect {
       const Eigen::Vector3d dir(sinTheta * std::cos(phi), cosTheta, sinTheta * std::sin(phi));
       const double r = 0.5 * spec_.nozzle_diameter + launchSpread_ * rng.uniform();
       const Eigen::Vector3d p = spec_.nozzle_position + r * dir;
-      s.balance.injected += s.dropletsPerParcel;
       if (ctx.apparatus.signedDistance(p) > 0.0) {
         s.parcels.push(p, s.dropletsPerParcel, index);
       } else {
@@ -117,6 +116,8 @@ class SprayEffect final : public TracerEffect {
       }
     }
     s.injectedParcels += n;
+    // From the integer count, not a running sum: exact to one rounding however long the run.
+    s.balance.injected = double(s.injectedParcels) * s.dropletsPerParcel;
   }
 
   void moveParcels(TracerContext& ctx, SprayState& s) const {

@@ -43,7 +43,7 @@ struct SprayState {
   std::vector<double> cellDeposit;      ///< droplets stripped from parcels per cell in the current step
   std::vector<double> cellPending;      ///< stripped droplets not yet handed to a tracer (< 1 per cell)
   double assigned = 0.0;                ///< droplets handed to tracers (whole droplets)
-  std::vector<double> tracerDroplets;   ///< droplets collected per real particle, per tracer
+  std::vector<double> tracerDroplets;   ///< whole droplets collected by each tracer (all its particles)
   std::vector<double> parcelDeposit;    ///< scratch: droplets each parcel deposits this step
   std::vector<std::int32_t> parcelCell; ///< scratch: each parcel's cell this step
 

@@ -31,7 +31,7 @@ std::shared_ptr<FieldDatabase> swirlingDatabase(const Scene& s, int frames) {
 }
 
 Scene fullTracerScene() {
-  Scene s = boxScene({0.1, 0.15, 0.04}, 0.01, 1500, 0.005,
+  Scene s = boxScene({0.1, 0.15, 0.04}, 0.01, 5000, 0.005,  // above kParallelThreshold
                      {"transport", "walls", "fluctuation", "free_flight", "tracer_volume_fraction", "probes",
                       "residence_time", "field_average"},
                      0.3);
@@ -125,8 +125,8 @@ TEST(Effects, MissingDependencyIsRefused) {
 TEST(Determinism, OneAndTwoThreadsAreBitIdentical) {
   const Scene s = fullTracerScene();
   auto db = swirlingDatabase(s, 12);
-  const RunResult one = runFor(s, db, 80, 1);
-  const RunResult two = runFor(s, db, 80, 2);
+  const RunResult one = runFor(s, db, 50, 1);
+  const RunResult two = runFor(s, db, 50, 2);
   EXPECT_TRUE(bitIdentical(one.cloud.x, two.cloud.x));
   EXPECT_TRUE(bitIdentical(one.cloud.y, two.cloud.y));
   EXPECT_TRUE(bitIdentical(one.cloud.z, two.cloud.z));
@@ -138,8 +138,8 @@ TEST(Determinism, OneAndTwoThreadsAreBitIdentical) {
 TEST(Determinism, ResumedRunEqualsUninterruptedRun) {
   const Scene s = fullTracerScene();
   auto db = swirlingDatabase(s, 12);
-  const RunResult straight = runFor(s, db, 80, 2);
-  const RunResult resumed = runFor(s, db, 80, 2, 37);
+  const RunResult straight = runFor(s, db, 50, 2);
+  const RunResult resumed = runFor(s, db, 50, 2, 23);
   EXPECT_TRUE(bitIdentical(straight.cloud.x, resumed.cloud.x));
   EXPECT_TRUE(bitIdentical(straight.cloud.z, resumed.cloud.z));
   EXPECT_EQ(straight.summary.dump(), resumed.summary.dump());
