@@ -105,6 +105,20 @@ TEST_F(Api, UnknownOrFailedDatabaseReferenceIs422) {
   expectProblem(server_->post("/v1/jobs", spray.dump()), 422);
 }
 
+TEST_F(Api, SprayOnAQueuedDatabaseJobIsAcceptedAndWaits) {
+  const std::string db = server_->post("/v1/jobs", databaseJob(9).dump()).json().at("id");
+  const nlohmann::json spray = {{"kind", "spray"}, {"scene", quickScene()}, {"database", db},
+                                {"duration", 1.0}};
+  const auto r = server_->post("/v1/jobs", spray.dump());
+  ASSERT_EQ(r.status, 202) << r.body;
+  EXPECT_EQ(r.json().at("database"), db);
+  EXPECT_EQ(r.json().at("state"), "QUEUED");
+  // A spray job without a database is refused.
+  auto none = spray;
+  none.erase("database");
+  expectProblem(server_->post("/v1/jobs", none.dump()), 422);
+}
+
 TEST_F(Api, OversizeBodyIs413) {
   const std::string big(2u << 20, ' ');  // 2 MiB of whitespace, over the 1 MiB JSON limit
   const auto r = server_->post("/v1/jobs", big);

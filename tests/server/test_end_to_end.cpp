@@ -291,7 +291,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   {
     auto server = start(1);
     db = upload(*server);
-    interrupted = submit(*server, sprayJob(db, 0.6, 5));
+    interrupted = submit(*server, sprayJob(db, 2.0, 5));
     const auto running = pollJob(*server, interrupted, [](const nlohmann::json& j) {
       return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0.1;
     });
@@ -312,7 +312,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   const auto resumed = pollJob(*server, interrupted, isFinal, std::chrono::seconds(90));
   ASSERT_EQ(resumed.at("state"), "SUCCEEDED") << resumed.dump(2);
   EXPECT_EQ(resumed.at("attempt"), 2);
-  const std::string reference = submit(*server, sprayJob(db, 0.6, 5));
+  const std::string reference = submit(*server, sprayJob(db, 2.0, 5));
   ASSERT_EQ(pollJob(*server, reference, isFinal, std::chrono::seconds(90)).at("state"), "SUCCEEDED");
   const auto a = server->get("/v1/jobs/" + interrupted + "/result").json();
   const auto b = server->get("/v1/jobs/" + reference + "/result").json();
@@ -330,7 +330,7 @@ TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   {
     auto server = start(1);
     const std::string db = upload(*server);
-    id = submit(*server, sprayJob(db, 0.6, 4));
+    id = submit(*server, sprayJob(db, 2.0, 4));
     const auto running = pollJob(*server, id, [](const nlohmann::json& j) {
       return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0;
     });
