@@ -215,6 +215,9 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       ::dup2(devnull, 0);
       ::dup2(pipeFds[1], 1);
       ::dup2(logFd, 2);
+      // The solver must not hold the server's sockets (listener, client connections): a connection
+      // it kept open would outlive the server's close or be reset when the solver exits.
+      ::close_range(3, ~0U, 0);
       ::execv(argv[0], const_cast<char* const*>(argv.data()));
       const char msg[] = "rcfd-server: cannot execute the solver\n";
       (void)!::write(2, msg, sizeof msg - 1);
