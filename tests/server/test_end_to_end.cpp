@@ -353,6 +353,7 @@ TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
 TEST_F(EndToEnd, CancelRunningJobCheckpointsAndEndsCancelled) {
   auto server = start(1);
   const std::string db = upload(*server);
+  try {
   const std::string id = submit(*server, sprayJob(db, 1000.0, 3));
   ASSERT_EQ(pollJob(*server, id, [](const nlohmann::json& j) { return j.at("state") == "RUNNING"; })
                 .at("state"),
@@ -362,6 +363,9 @@ TEST_F(EndToEnd, CancelRunningJobCheckpointsAndEndsCancelled) {
   EXPECT_EQ(r.json().at("state"), "CANCELLING");
   const auto done = pollJob(*server, id, isFinal);
   EXPECT_EQ(done.at("state"), "CANCELLED") << done.dump(2);
+  } catch (const std::exception& e) {
+    FAIL() << e.what() << "; server alive: " << server->alive() << "; stderr:\n" << server->stderrText();
+  }
 }
 
 TEST_F(EndToEnd, InvalidUploadIs422NamingTheDataset) {
