@@ -1,0 +1,47 @@
+#pragma once
+/// \file HttpClient.hpp
+/// A small synchronous HTTP/1.1 client (Boost.Beast) for the rcfd client: one connection per
+/// request, bearer token, JSON bodies, streamed file uploads and downloads.
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace rcfd::client {
+
+/// The server could not be reached or the exchange broke off.
+class ConnectionError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct HttpResponse {
+  int status = 0;
+  std::map<std::string, std::string> headers;  ///< lower-case names
+  std::string body;                            ///< empty when streamed to a file
+  std::string contentType() const;
+  bool ok() const { return status >= 200 && status < 300; }
+};
+
+class HttpClient {
+ public:
+  /// `server` like "http://127.0.0.1:8080" (http only); throws std::invalid_argument otherwise.
+  HttpClient(const std::string& server, std::string token);
+
+  HttpResponse get(const std::string& target);
+  HttpResponse post(const std::string& target, const std::string& jsonBody,
+                    const std::map<std::string, std::string>& headers = {});
+  /// POSTs a file as application/octet-stream without loading it into memory.
+  HttpResponse postFile(const std::string& target, const std::filesystem::path& file);
+  /// GETs into a file (written only if the answer is 2xx; otherwise the body is returned).
+  HttpResponse download(const std::string& target, const std::filesystem::path& file);
+
+  const std::string& server() const { return server_; }
+
+ private:
+  std::string server_, host_, port_, token_;
+};
+
+}  // namespace rcfd::client

@@ -1,0 +1,23 @@
+#pragma once
+/// \file DatabaseRef.hpp
+/// What a job's "database" reference points at on the server: the database.h5 of a database job
+/// (usable once that job SUCCEEDED, pending while it is QUEUED or RUNNING) or an uploaded database.
+
+#include <filesystem>
+#include <string>
+
+namespace rcfd::server {
+
+class JobStore;
+struct ServerConfig;
+
+struct DatabaseRef {
+  enum class Status { ready, pending, failed, unknown };
+  Status status = Status::unknown;
+  std::filesystem::path path;  ///< the HDF5 file (ready, pending)
+  std::string detail;          ///< why it is failed or unknown, for messages
+};
+
+DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, const std::string& ref);
+
+}  // namespace rcfd::server

@@ -1,0 +1,179 @@
+#include "HttpSession.hpp"
+
+#include <boost/asio/dispatch.hpp>
+#include <boost/asio/post.hpp>
+
+#include "Problem.hpp"
+
+namespace rcfd::server {
+
+namespace beast = boost::beast;
+namespace net = boost::asio;
+
+namespace {
+constexpr std::uint32_t kHeaderLimit = 16 * 1024;     // bytes of a request header
+constexpr std::size_t kDrainLimit = 64u << 20;        // unread body bytes discarded before closing
+constexpr auto kDrainTimeout = std::chrono::seconds(5);
+}  // namespace
+
+HttpSession::HttpSession(net::ip::tcp::socket&& socket, Router& router, net::thread_pool& blocking)
+    : stream_(std::move(socket)), router_(router), blocking_(blocking) {}
+
+HttpSession::~HttpSession() {
+  if (!uploadPath_.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(uploadPath_, ec);  // an interrupted upload leaves nothing behind
+  }
+}
+
+void HttpSession::run() {
+  net::dispatch(stream_.get_executor(),
+                beast::bind_front_handler(&HttpSession::doRead, shared_from_this()));
+}
+
+void HttpSession::doRead() {
+  header_.emplace();
+  header_->header_limit(kHeaderLimit);
+  // The header parser checks Content-Length against its body limit; the route's own limit is
+  // applied once the route is known (onHeader).
+  header_->body_limit(std::max<std::uint64_t>(router_.config().uploadLimit,
+                                              router_.config().jsonBodyLimit));
+  body_.reset();
+  upload_.reset();
+  stream_.expires_after(router_.config().readTimeout);
+  http::async_read_header(stream_, buffer_, *header_,
+                          beast::bind_front_handler(&HttpSession::onHeader, shared_from_this()));
+}
+
+void HttpSession::readError(beast::error_code ec) {
+  if (ec == http::error::end_of_stream || ec == net::error::eof ||
+      ec == net::error::connection_reset || ec == beast::error::timeout ||
+      ec == net::error::operation_aborted) {
+    beast::error_code ignored;
+    stream_.socket().shutdown(net::ip::tcp::socket::shutdown_send, ignored);
+    return;
+  }
+  started_ = std::chrono::steady_clock::now();
+  if (ec == http::error::body_limit) {
+    send(problem(http::status::payload_too_large, "body-too-large", "Request body too large",
+                 "the body exceeds the limit of this endpoint", ""),
+         false);
+    return;
+  }
+  if (ec == http::error::header_limit) {
+    send(problem(http::status::request_header_fields_too_large, "header-too-large",
+                 "Request header too large", "the header exceeds 16 KiB", ""),
+         false);
+    return;
+  }
+  send(problem(http::status::bad_request, "malformed-http", "Malformed HTTP request", ec.message(), ""),
+       false);
+}
+
+void HttpSession::onHeader(beast::error_code ec, std::size_t) {
+  if (ec) return readError(ec);
+  started_ = std::chrono::steady_clock::now();
+  const auto& req = header_->get();
+  const std::string_view target(req.target().data(), req.target().size());
+  if (Router::isUpload(req.method(), target)) {
+    if (!router_.authorized(req)) return send(router_.unauthorized(std::string(target)), false);
+    upload_.emplace(std::move(*header_));
+    upload_->body_limit(router_.config().uploadLimit);
+    uploadPath_ = router_.databases().temporaryUploadPath();
+    beast::error_code fileError;
+    upload_->get().body().open(uploadPath_.c_str(), beast::file_mode::write, fileError);
+    if (fileError)
+      return send(problem(http::status::internal_server_error, "storage-failed", "Storage failed",
+                          "cannot create the upload file: " + fileError.message(), "/v1/databases"),
+                  false);
+    stream_.expires_after(router_.config().uploadTimeout);
+    http::async_read(stream_, buffer_, *upload_,
+                     beast::bind_front_handler(&HttpSession::onUpload, shared_from_this()));
+    return;
+  }
+  const auto length = header_->content_length();
+  if (length && *length > router_.config().jsonBodyLimit)
+    return send(problem(http::status::payload_too_large, "body-too-large", "Request body too large",
+                        "the body has " + std::to_string(*length) + " bytes; the limit is " +
+                            std::to_string(router_.config().jsonBodyLimit),
+                        std::string(target)),
+                false);
+  body_.emplace(std::move(*header_));
+  body_->body_limit(router_.config().jsonBodyLimit);
+  http::async_read(stream_, buffer_, *body_,
+                   beast::bind_front_handler(&HttpSession::onBody, shared_from_this()));
+}
+
+void HttpSession::onBody(beast::error_code ec, std::size_t) {
+  if (ec) return readError(ec);
+  started_ = std::chrono::steady_clock::now();
+  Request req = body_->release();
+  const bool keepAlive = req.keep_alive();
+  // Handlers only read and write short SQLite rows or small files, so they run here on the strand.
+  send(router_.handle(req), keepAlive);
+}
+
+void HttpSession::onUpload(beast::error_code ec, std::size_t) {
+  if (ec) return readError(ec);
+  auto req = upload_->release();
+  req.body().close();
+  const bool keepAlive = req.keep_alive();
+  const auto target = parseTarget(std::string(req.target()));
+  // Validation opens the HDF5 file: off the io threads, then back to this strand to answer.
+  net::post(blocking_, [self = shared_from_this(), keepAlive, target] {
+    auto path = self->uploadPath_;
+    StringResponse res = self->router_.databases().accept(path, target.value_or(Target{"/v1/databases", {}, {}, false}));
+    net::post(self->stream_.get_executor(), [self, keepAlive, res = std::move(res)]() mutable {
+      self->uploadPath_.clear();  // moved into place or deleted by accept()
+      self->send(std::move(res), keepAlive);
+    });
+  });
+}
+
+void HttpSession::send(Response&& res, bool keepAlive) {
+  std::visit(
+      [&](auto& message) {
+        using Message = std::decay_t<decltype(message)>;
+        auto sp = std::make_shared<Message>(std::move(message));
+        sp->keep_alive(keepAlive);
+        sp->set(http::field::server, "rcfd-server");
+        status_ = static_cast<int>(sp->result_int());
+        response_ = sp;
+        http::async_write(stream_, *sp,
+                          beast::bind_front_handler(&HttpSession::onWrite, shared_from_this(),
+                                                    sp->need_eof()));
+      },
+      res);
+}
+
+void HttpSession::onWrite(bool close, beast::error_code ec, std::size_t) {
+  router_.metrics().observe(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count(), status_);
+  response_.reset();
+  if (ec) return;
+  if (close) return lingeringClose();
+  doRead();
+}
+
+void HttpSession::lingeringClose() {
+  // Closing with unread request bytes makes the kernel send RST, which can destroy the response
+  // before the client reads it; so shut down our side and discard input for a while first.
+  beast::error_code ignored;
+  stream_.socket().shutdown(net::ip::tcp::socket::shutdown_send, ignored);
+  stream_.expires_after(kDrainTimeout);
+  stream_.async_read_some(net::buffer(scratch_),
+                          beast::bind_front_handler(&HttpSession::onDrain, shared_from_this()));
+}
+
+void HttpSession::onDrain(beast::error_code ec, std::size_t n) {
+  drained_ += n;
+  if (ec || drained_ > kDrainLimit) {
+    beast::error_code ignored;
+    stream_.socket().close(ignored);
+    return;
+  }
+  stream_.async_read_some(net::buffer(scratch_),
+                          beast::bind_front_handler(&HttpSession::onDrain, shared_from_this()));
+}
+
+}  // namespace rcfd::server

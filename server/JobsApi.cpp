@@ -1,0 +1,349 @@
+#include "JobsApi.hpp"
+
+#include <filesystem>
+#include <regex>
+
+#include "CoverageExport.hpp"
+#include "DatabaseRef.hpp"
+#include "Ids.hpp"
+#include "Problem.hpp"
+#include "WorkerPool.hpp"
+#include "scene/SceneLoader.hpp"
+
+namespace rcfd::server {
+
+namespace {
+
+constexpr int kDefaultPageSize = 50;
+constexpr int kMaxPageSize = 1000;
+constexpr std::size_t kMaxIdempotencyKey = 200;
+constexpr const char* kRetryAfterSeconds = "2";
+const char* const kFixedArtifacts[] = {"database.h5", "result.h5", "summary.json", "solver.log",
+                                       "job.json"};
+
+StringResponse notFound(const std::string& id, const Target& target) {
+  return problem(http::status::not_found, "job-not-found", "Job not found",
+                 "there is no job with id \"" + id + "\"", target.path);
+}
+
+StringResponse notFinished(const JobRecord& job, const Target& target, const std::string& what) {
+  return problem(http::status::conflict, "job-not-succeeded", "Job has not succeeded",
+                 what + " exists only for SUCCEEDED jobs; job " + job.id + " is " + job.state +
+                     (job.error.empty() ? std::string() : " (" + job.error + ")"),
+                 target.path);
+}
+
+StringResponse badParameter(const std::string& name, const std::string& message,
+                            const Target& target) {
+  return problem(http::status::bad_request, "invalid-parameter", "Invalid query parameter",
+                 name + ": " + message, target.path,
+                 nlohmann::json::array({{{"pointer", name}, {"message", message}}}));
+}
+
+std::string contentTypeFor(const std::string& name) {
+  const auto ext = std::filesystem::path(name).extension().string();
+  if (ext == ".h5") return "application/x-hdf5";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".json") return "application/json";
+  return "text/plain; charset=utf-8";
+}
+
+}  // namespace
+
+bool isArtifactName(const std::string& name) {
+  for (const char* fixed : kFixedArtifacts)
+    if (name == fixed) return true;
+  static const std::regex svg("[A-Za-z0-9][A-Za-z0-9_-]*(\\.[A-Za-z0-9_-]+)*\\.svg");
+  return name.size() <= 128 && std::regex_match(name, svg);
+}
+
+std::vector<std::string> JobsApi::artifacts(const std::string& id) const {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(config_.jobDir(id), ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && isArtifactName(name)) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+nlohmann::json JobsApi::toJson(const JobRecord& job, bool withRequest) const {
+  const auto orNull = [](const std::string& s) { return s.empty() ? nlohmann::json() : nlohmann::json(s); };
+  const auto optNum = [](const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); };
+  const std::string self = "/v1/jobs/" + job.id;
+  nlohmann::json j = {
+      {"id", job.id},
+      {"kind", job.kind},
+      {"state", job.state},
+      {"progress",
+       {{"fraction", job.progress},
+        {"sim_time", optNum(job.simTime)},
+        {"wall_time", optNum(job.wallTime)},
+        {"eta_s", optNum(job.etaS)}}},
+      {"database", orNull(job.databaseRef)},
+      {"attempt", job.attempt},
+      {"error", orNull(job.error)},
+      {"created_at", job.createdAt},
+      {"started_at", orNull(job.startedAt)},
+      {"finished_at", orNull(job.finishedAt)},
+      {"updated_at", job.updatedAt},
+      {"links",
+       {{"self", self},
+        {"cancel", self + ":cancel"},
+        {"events", self + "/events"},
+        {"result", self + "/result"},
+        {"coverage", self + "/coverage"}}},
+  };
+  if (job.state == state::succeeded || job.state == state::failed) j["artifacts"] = artifacts(job.id);
+  if (withRequest) j["request"] = nlohmann::json::parse(job.request);
+  return j;
+}
+
+Response JobsApi::submit(const Request& req, const Target& target) {
+  auto document = nlohmann::json::parse(req.body(), nullptr, false);
+  if (document.is_discarded()) {
+    std::string detail = "the request body is not valid JSON";
+    try {
+      const auto ignored = nlohmann::json::parse(req.body());
+      (void)ignored;
+    } catch (const nlohmann::json::parse_error& e) {
+      detail += ": " + std::string(e.what());
+    }
+    return problem(http::status::bad_request, "invalid-json", "Malformed JSON", detail, target.path);
+  }
+  if (document.is_object() && document.contains("scene_file"))
+    return invalidInput(
+        InputError("job", "/scene_file",
+                   "the server reads no files: inline the scene as \"scene\" (rcfd submit does this)"),
+        target.path);
+  JobSpec spec;
+  try {
+    spec = loadJob(document, "job");
+  } catch (const InputError& e) {
+    return invalidInput(e, target.path);
+  }
+  if (spec.kind != "database" && spec.database.empty())
+    return invalidInput(InputError("job", "/database",
+                                   "required for " + spec.kind +
+                                       " jobs: the id of a database job or an uploaded database"),
+                        target.path);
+  if (!spec.database.empty()) {
+    const DatabaseRef ref = resolveDatabaseRef(store_, config_, spec.database);
+    if (ref.status == DatabaseRef::Status::unknown || ref.status == DatabaseRef::Status::failed)
+      return invalidInput(InputError("job", "/database", ref.detail), target.path);
+  }
+
+  std::string key;
+  if (auto it = req.find("Idempotency-Key"); it != req.end()) {
+    key = std::string(it->value());
+    if (key.empty() || key.size() > kMaxIdempotencyKey)
+      return problem(http::status::bad_request, "invalid-idempotency-key", "Invalid Idempotency-Key",
+                     "the Idempotency-Key header must have 1 to 200 characters", target.path);
+  }
+  JobRecord job;
+  job.id = newId();
+  job.kind = spec.kind;
+  job.request = document.dump();
+  job.bodyHash = bodyHash(job.request);
+  job.idempotencyKey = key;
+  job.databaseRef = spec.database;
+  const auto inserted = store_.insertJob(job);
+  if (!inserted.created && inserted.job.bodyHash != job.bodyHash)
+    return problem(http::status::unprocessable_entity, "idempotency-key-reused",
+                   "Idempotency-Key reused with a different body",
+                   "Idempotency-Key \"" + key + "\" was used for job " + inserted.job.id +
+                       " with a different request body",
+                   target.path);
+  if (inserted.created) pool_.wake();
+  auto res = jsonResponse(http::status::accepted, toJson(inserted.job));
+  res.set(http::field::location, "/v1/jobs/" + inserted.job.id);
+  res.set(http::field::retry_after, kRetryAfterSeconds);
+  if (!inserted.created) res.set("Idempotent-Replayed", "true");
+  return res;
+}
+
+Response JobsApi::list(const Target& target) {
+  JobFilter filter;
+  filter.limit = kDefaultPageSize;
+  if (auto it = target.query.find("state"); it != target.query.end()) {
+    if (!state::isValid(it->second))
+      return badParameter("state", "\"" + it->second +
+                                       "\" is not one of QUEUED, RUNNING, SUCCEEDED, FAILED, "
+                                       "CANCELLING, CANCELLED",
+                          target);
+    filter.state = it->second;
+  }
+  if (auto it = target.query.find("kind"); it != target.query.end()) {
+    if (it->second != "database" && it->second != "calibration" && it->second != "spray")
+      return badParameter("kind", "\"" + it->second + "\" is not one of database, calibration, spray",
+                          target);
+    filter.kind = it->second;
+  }
+  if (auto it = target.query.find("page_size"); it != target.query.end()) {
+    int n = 0;
+    try {
+      std::size_t used = 0;
+      n = std::stoi(it->second, &used);
+      if (used != it->second.size()) n = 0;
+    } catch (...) {
+      n = 0;
+    }
+    if (n < 1 || n > kMaxPageSize)
+      return badParameter("page_size", "must be an integer from 1 to 1000", target);
+    filter.limit = n;
+  }
+  if (auto it = target.query.find("page_token"); it != target.query.end()) {
+    // The token carries the filters it was issued for, so a page never mixes two listings.
+    const auto decoded = base64UrlDecode(it->second);
+    auto token = decoded ? nlohmann::json::parse(*decoded, nullptr, false) : nlohmann::json();
+    if (!token.is_object() || !token.contains("after") || !token["after"].is_number_integer() ||
+        token.value("state", "") != filter.state || token.value("kind", "") != filter.kind)
+      return badParameter("page_token",
+                          "not a token from a previous page of this listing (same filters)", target);
+    filter.afterSeq = token["after"].get<std::int64_t>();
+  }
+  // Fetch one more than asked: whether it exists decides if there is a next page.
+  const int pageSize = filter.limit;
+  filter.limit = pageSize + 1;
+  auto rows = store_.listJobs(filter);
+  nlohmann::json body = {{"jobs", nlohmann::json::array()}};
+  const bool more = static_cast<int>(rows.size()) > pageSize;
+  if (more) rows.resize(static_cast<std::size_t>(pageSize));
+  for (const auto& job : rows) body["jobs"].push_back(toJson(job));
+  if (more) {
+    const nlohmann::json token = {
+        {"after", rows.back().seq}, {"state", filter.state}, {"kind", filter.kind}};
+    body["next_page_token"] = base64UrlEncode(token.dump());
+  }
+  return jsonResponse(http::status::ok, body);
+}
+
+Response JobsApi::get(const std::string& id, const Target& target) {
+  const auto job = store_.job(id);
+  if (!job) return notFound(id, target);
+  const auto view = target.query.find("view");
+  return jsonResponse(http::status::ok, toJson(*job, view != target.query.end() && view->second == "full"));
+}
+
+Response JobsApi::events(const std::string& id, const Target& target) {
+  if (!store_.job(id)) return notFound(id, target);
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : store_.events(id))
+    out.push_back({{"at", e.at},
+                   {"from", e.from.empty() ? nlohmann::json() : nlohmann::json(e.from)},
+                   {"to", e.to},
+                   {"reason", e.reason}});
+  return jsonResponse(http::status::ok, {{"events", out}});
+}
+
+Response JobsApi::cancel(const std::string& id, const Target& target) {
+  // Compare-and-set loop: the worker pool may move the job between our read and our write.
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    const auto job = store_.job(id);
+    if (!job) return notFound(id, target);
+    if (state::isFinal(job->state))
+      return problem(http::status::conflict, "job-finished", "Job already finished",
+                     "job " + id + " is " + job->state + " and cannot be cancelled", target.path);
+    if (job->state == state::cancelling) return jsonResponse(http::status::accepted, toJson(*job));
+    if (job->state == state::queued &&
+        store_.transition(id, state::queued, state::cancelled, "cancelled by request"))
+      return jsonResponse(http::status::ok, toJson(*store_.job(id)));
+    if (job->state == state::running &&
+        store_.transition(id, state::running, state::cancelling, "cancel requested")) {
+      pool_.terminate(id);
+      return jsonResponse(http::status::accepted, toJson(*store_.job(id)));
+    }
+  }
+  return problem(http::status::conflict, "job-busy", "Job changed state repeatedly",
+                 "try the cancel again", target.path);
+}
+
+Response JobsApi::result(const std::string& id, const Target& target) {
+  const auto job = store_.job(id);
+  if (!job) return notFound(id, target);
+  if (job->state != state::succeeded) return notFinished(*job, target, "a result");
+  const auto summary = store_.summary(id);
+  if (!summary)
+    return problem(http::status::internal_server_error, "summary-missing", "Summary missing",
+                   "job " + id + " succeeded but its summary is not stored", target.path);
+  return jsonResponse(http::status::ok, *summary);
+}
+
+Response JobsApi::coverage(const std::string& id, const Target& target) {
+  const auto job = store_.job(id);
+  if (!job) return notFound(id, target);
+  if (job->state != state::succeeded) return notFinished(*job, target, "a coverage distribution");
+  std::string format = "json";
+  if (auto it = target.query.find("format"); it != target.query.end()) format = it->second;
+  if (format != "json" && format != "csv" && format != "h5")
+    return badParameter("format", "\"" + format + "\" is not one of json, csv, h5", target);
+  const auto stored = store_.coverage(id);
+  if (stored.empty())
+    return problem(http::status::not_found, "no-coverage", "No coverage distribution",
+                   "job " + id + " (" + job->kind + ") has no coverage histogram; spray jobs have one",
+                   target.path);
+  std::vector<CoverageBin> bins = stored;
+  if (auto it = target.query.find("bins"); it != target.query.end()) {
+    std::size_t n = 0;
+    try {
+      std::size_t used = 0;
+      n = std::stoul(it->second, &used);
+      if (used != it->second.size()) n = 0;
+    } catch (...) {
+      n = 0;
+    }
+    if (n == 0 || stored.size() % n != 0)
+      return badParameter("bins",
+                          "must divide the stored " + std::to_string(stored.size()) +
+                              " bins (adjacent bins are merged); allowed: " +
+                              divisorsText(stored.size()),
+                          target);
+    bins = mergeBins(stored, n);
+  }
+  if (format == "json") return jsonResponse(http::status::ok, coverageJson(id, bins));
+  if (format == "csv") {
+    auto res = textResponse(http::status::ok, coverageCsv(bins), "text/csv; charset=utf-8");
+    res.set(http::field::content_disposition, "attachment; filename=\"coverage.csv\"");
+    return res;
+  }
+  const auto path = config_.jobDir(id) / ("coverage_" + std::to_string(bins.size()) + ".h5.export");
+  std::string error;
+  if (!writeCoverageH5(path, id, bins, error))
+    return problem(http::status::internal_server_error, "export-failed", "Export failed", error,
+                   target.path);
+  FileResponse res{http::status::ok, 11};
+  boost::beast::error_code ec;
+  res.body().open(path.c_str(), boost::beast::file_mode::scan, ec);
+  if (ec)
+    return problem(http::status::internal_server_error, "export-failed", "Export failed",
+                   ec.message(), target.path);
+  res.set(http::field::content_type, "application/x-hdf5");
+  res.set(http::field::content_disposition, "attachment; filename=\"coverage.h5\"");
+  res.prepare_payload();
+  return res;
+}
+
+Response JobsApi::artifact(const std::string& id, const std::string& name, const Target& target) {
+  if (!isArtifactName(name))
+    return problem(http::status::bad_request, "invalid-artifact-name", "Invalid artifact name",
+                   "\"" + name + "\" is not an artifact name: database.h5, result.h5, summary.json, "
+                   "solver.log, job.json or a figure NAME.svg; paths are never accepted",
+                   target.path);
+  const auto job = store_.job(id);
+  if (!job) return notFound(id, target);
+  const auto path = config_.jobDir(id) / name;
+  FileResponse res{http::status::ok, 11};
+  boost::beast::error_code ec;
+  if (std::filesystem::is_regular_file(path)) res.body().open(path.c_str(), boost::beast::file_mode::scan, ec);
+  if (!std::filesystem::is_regular_file(path) || ec)
+    return problem(http::status::not_found, "artifact-not-found", "Artifact not found",
+                   "job " + id + " (" + job->state + ") has no artifact \"" + name + "\"",
+                   target.path);
+  res.set(http::field::content_type, contentTypeFor(name));
+  res.set(http::field::content_disposition, "attachment; filename=\"" + name + "\"");
+  res.prepare_payload();
+  return res;
+}
+
+}  // namespace rcfd::server

@@ -1,0 +1,157 @@
+#include "Router.hpp"
+
+#include "Ids.hpp"
+#include "Problem.hpp"
+#include "WorkerPool.hpp"
+#include "scene/SceneLoader.hpp"
+
+namespace rcfd::server {
+
+namespace {
+constexpr const char* kVersion = "0.1.0";
+
+StringResponse methodNotAllowed(const Target& target, const std::string& allow) {
+  auto res = problem(http::status::method_not_allowed, "method-not-allowed", "Method not allowed",
+                     target.path + " supports " + allow, target.path);
+  res.set(http::field::allow, allow);
+  return res;
+}
+
+StringResponse noRoute(const Target& target) {
+  return problem(http::status::not_found, "not-found", "Not found",
+                 "no resource at " + target.path + " (the API lives under /v1; see docs/api.md)",
+                 target.path);
+}
+
+/// Constant-time comparison: the time taken does not reveal how much of a token matched.
+bool sameSecret(std::string_view a, std::string_view b) {
+  if (a.size() != b.size() || b.empty()) return false;
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+}  // namespace
+
+Router::Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const ServerConfig& config)
+    : store_(store),
+      pool_(pool),
+      metrics_(metrics),
+      config_(config),
+      jobs_(store, pool, config),
+      databases_(store, config) {}
+
+bool Router::isPublic(http::verb method, std::string_view target) {
+  return method == http::verb::get && (target == "/v1/health" || target.rfind("/v1/health?", 0) == 0);
+}
+
+bool Router::isUpload(http::verb method, std::string_view target) {
+  const auto path = target.substr(0, target.find('?'));
+  return method == http::verb::post && (path == "/v1/databases" || path == "/v1/databases/");
+}
+
+bool Router::authorized(const http::fields& headers) const {
+  const auto it = headers.find(http::field::authorization);
+  if (it == headers.end()) return false;
+  const std::string_view value(it->value().data(), it->value().size());
+  constexpr std::string_view scheme = "Bearer ";
+  if (value.size() <= scheme.size() || !boost::beast::iequals(boost::beast::string_view(value.data(), scheme.size()),
+                              boost::beast::string_view(scheme.data(), scheme.size())))
+    return false;
+  return sameSecret(value.substr(scheme.size()), config_.token);
+}
+
+StringResponse Router::unauthorized(const std::string& target) const {
+  auto res = problem(http::status::unauthorized, "unauthorized", "Unauthorized",
+                     "send \"Authorization: Bearer <token>\" with the server's token "
+                     "(rcfd --token or RCFD_TOKEN)",
+                     target);
+  res.set(http::field::www_authenticate, "Bearer realm=\"rcfd\"");
+  return res;
+}
+
+Response Router::handle(const Request& req) {
+  const std::string raw(req.target());
+  const auto target = parseTarget(raw);
+  if (!target)
+    return problem(http::status::bad_request, "invalid-target", "Malformed request target",
+                   "the request target is not a valid path and query", raw.substr(0, 200));
+  if (!isPublic(req.method(), raw) && !authorized(req)) return unauthorized(target->path);
+  if (target->dotSegment)
+    return problem(http::status::bad_request, "invalid-target", "Path segments . and .. refused",
+                   "resource names are never paths", target->path);
+  try {
+    return route(req, *target);
+  } catch (const std::exception& e) {
+    return problem(http::status::internal_server_error, "internal", "Internal server error",
+                   e.what(), target->path);
+  }
+}
+
+Response Router::route(const Request& req, const Target& target) {
+  const auto& s = target.segments;
+  const auto method = req.method();
+  const bool get = method == http::verb::get;
+  const bool post = method == http::verb::post;
+
+  if (s.size() == 1 && s[0] == "metrics") {
+    if (!get) return methodNotAllowed(target, "GET");
+    return textResponse(http::status::ok, metrics_.render(store_, pool_.busy(), pool_.slots()),
+                        "text/plain; version=0.0.4; charset=utf-8");
+  }
+  if (s.empty() || s[0] != "v1") return noRoute(target);
+
+  if (s.size() == 2 && s[1] == "health") {
+    if (!get) return methodNotAllowed(target, "GET");
+    return jsonResponse(http::status::ok, {{"status", "ok"},
+                                           {"version", kVersion},
+                                           {"schema_version", store_.schemaVersion()},
+                                           {"workers", pool_.slots()},
+                                           {"workers_busy", pool_.busy()}});
+  }
+  if (s.size() == 3 && s[1] == "schemas") {
+    if (!get) return methodNotAllowed(target, "GET");
+    try {
+      return textResponse(http::status::ok, schemaText(s[2]), "application/schema+json");
+    } catch (const std::out_of_range&) {
+      return problem(http::status::not_found, "schema-not-found", "Schema not found",
+                     "no schema \"" + s[2] + "\"; available: scene, job", target.path);
+    }
+  }
+  if (s.size() >= 2 && s[1] == "databases") {
+    if (s.size() == 2) return methodNotAllowed(target, "POST");  // uploads are routed by the session
+    if (s.size() == 3) {
+      if (!get) return methodNotAllowed(target, "GET");
+      return databases_.get(s[2], target);
+    }
+    return noRoute(target);
+  }
+  if (s.size() >= 2 && s[1] == "jobs") {
+    if (s.size() == 2) {
+      if (post) return jobs_.submit(req, target);
+      if (get) return jobs_.list(target);
+      return methodNotAllowed(target, "GET, POST");
+    }
+    std::string id = s[2];
+    // Custom method (AIP-136): POST /v1/jobs/{id}:cancel
+    if (s.size() == 3 && id.size() > 7 && id.compare(id.size() - 7, 7, ":cancel") == 0) {
+      if (!post) return methodNotAllowed(target, "POST");
+      return jobs_.cancel(id.substr(0, id.size() - 7), target);
+    }
+    if (s.size() == 3) {
+      if (!get) return methodNotAllowed(target, "GET");
+      return jobs_.get(id, target);
+    }
+    if (s.size() == 4 && !get) return methodNotAllowed(target, "GET");
+    if (s.size() == 4 && s[3] == "result") return jobs_.result(id, target);
+    if (s.size() == 4 && s[3] == "coverage") return jobs_.coverage(id, target);
+    if (s.size() == 4 && s[3] == "events") return jobs_.events(id, target);
+    if (s.size() == 5 && s[3] == "artifacts") {
+      if (!get) return methodNotAllowed(target, "GET");
+      return jobs_.artifact(id, s[4], target);
+    }
+    return noRoute(target);
+  }
+  return noRoute(target);
+}
+
+}  // namespace rcfd::server

@@ -1,0 +1,27 @@
+#pragma once
+/// \file ServerConfig.hpp
+/// rcfd-server's settings, from its command line (main.cpp).
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace rcfd::server {
+
+struct ServerConfig {
+  std::filesystem::path dataDir;      ///< rcfd.sqlite, jobs/<id>/, databases/
+  std::string token;                  ///< bearer token required on everything but /v1/health
+  int workers = 1;                    ///< concurrent solver processes (0: jobs stay QUEUED)
+  std::filesystem::path solverPath;   ///< the rcfd-solve executable
+  std::uint64_t jsonBodyLimit = 1u << 20;            ///< bytes of a JSON request body
+  std::uint64_t uploadLimit = 8ull << 30;            ///< bytes of an uploaded database
+  std::chrono::seconds readTimeout{30};              ///< header and JSON body read timeout
+  std::chrono::seconds uploadTimeout{3600};          ///< whole-upload timeout
+  std::chrono::seconds shutdownGrace{120};           ///< wait for solvers to checkpoint on stop
+
+  std::filesystem::path jobDir(const std::string& id) const { return dataDir / "jobs" / id; }
+  std::filesystem::path databaseDir() const { return dataDir / "databases"; }
+};
+
+}  // namespace rcfd::server

@@ -1,0 +1,383 @@
+#include "WorkerPool.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "DatabaseRef.hpp"
+#include "core/Errors.hpp"
+
+namespace rcfd::server {
+
+namespace {
+
+constexpr auto kProgressWriteInterval = std::chrono::milliseconds(250);  // throttle row updates
+constexpr std::size_t kReasonLines = 6;       // stderr lines quoted in a failure reason
+constexpr std::size_t kReasonMaxChars = 2000;
+
+std::optional<double> optionalNumber(const nlohmann::json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || !it->is_number()) return std::nullopt;
+  return it->get<double>();
+}
+
+/// The last non-empty lines the solver wrote to stderr during this attempt.
+std::string logTail(const std::filesystem::path& log, std::streamoff from) {
+  std::ifstream in(log, std::ios::binary);
+  if (!in) return {};
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  // Read at most the last 64 KiB of this attempt's output.
+  const std::streamoff start = std::max(from, size - std::streamoff(64 * 1024));
+  in.seekg(start);
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") != std::string::npos) lines.push_back(line);
+  }
+  std::string out;
+  const std::size_t first = lines.size() > kReasonLines ? lines.size() - kReasonLines : 0;
+  for (std::size_t i = first; i < lines.size(); ++i) out += (out.empty() ? "" : "\n") + lines[i];
+  if (out.size() > kReasonMaxChars) out = "..." + out.substr(out.size() - kReasonMaxChars);
+  return out;
+}
+
+std::string signalName(int sig) {
+  const char* abbrev = sigabbrev_np(sig);
+  std::string name = abbrev ? std::string("SIG") + abbrev : "signal " + std::to_string(sig);
+  return name + " (" + std::to_string(sig) + ")";
+}
+
+/// Coverage histogram bins from summary.json (CONTRACTS.md: coverage.histogram.{edges,counts}).
+std::vector<CoverageBin> coverageBins(const nlohmann::json& summary) {
+  std::vector<CoverageBin> bins;
+  const auto cov = summary.find("coverage");
+  if (cov == summary.end() || !cov->is_object()) return bins;
+  const auto hist = cov->find("histogram");
+  if (hist == cov->end() || !hist->is_object()) return bins;
+  const auto& edges = hist->value("edges", nlohmann::json::array());
+  const auto& counts = hist->value("counts", nlohmann::json::array());
+  if (!edges.is_array() || !counts.is_array() || edges.size() != counts.size() + 1) return bins;
+  for (std::size_t i = 0; i < counts.size(); ++i)
+    bins.push_back({edges[i].get<double>(), edges[i + 1].get<double>(), counts[i].get<double>()});
+  return bins;
+}
+
+}  // namespace
+
+WorkerPool::WorkerPool(JobStore& store, const ServerConfig& config)
+    : store_(store), config_(config) {}
+
+WorkerPool::~WorkerPool() { shutdown(); }
+
+void WorkerPool::start() {
+  for (const auto& job : store_.unfinished()) {
+    if (job.state == state::running)
+      store_.transition(job.id, state::running, state::queued,
+                        "server restarted; the job resumes from its checkpoint");
+    else
+      store_.transition(job.id, state::cancelling, state::cancelled,
+                        "server restarted while the job was cancelling");
+  }
+  scheduler_ = std::thread(&WorkerPool::schedulerLoop, this);
+}
+
+void WorkerPool::wake() {
+  {
+    std::lock_guard lock(mutex_);
+    pending_ = true;
+  }
+  wake_.notify_all();
+}
+
+int WorkerPool::busy() {
+  std::lock_guard lock(mutex_);
+  return static_cast<int>(threads_.size() - finished_.size());
+}
+
+void WorkerPool::terminate(const std::string& id) {
+  std::lock_guard lock(mutex_);
+  auto it = children_.find(id);
+  if (it != children_.end()) ::kill(it->second, SIGTERM);
+}
+
+bool WorkerPool::isRunnable(JobRecord& job) {
+  if (job.databaseRef.empty()) return true;
+  const DatabaseRef ref = resolveDatabaseRef(store_, config_, job.databaseRef);
+  switch (ref.status) {
+    case DatabaseRef::Status::ready:
+      return true;
+    case DatabaseRef::Status::pending:
+      return false;
+    default:
+      store_.transition(job.id, state::queued, state::failed, {},
+                        "its database cannot be used: " + ref.detail);
+      return false;
+  }
+}
+
+void WorkerPool::schedulerLoop() {
+  for (;;) {
+    std::vector<std::thread> toJoin;
+    int freeSlots = 0;
+    {
+      std::unique_lock lock(mutex_);
+      // Wake on demand, and every second anyway so jobs waiting on a database job are picked up.
+      wake_.wait_for(lock, std::chrono::seconds(1), [&] { return stopping_ || pending_; });
+      pending_ = false;
+      if (stopping_) return;
+      for (const auto& id : finished_) {
+        toJoin.push_back(std::move(threads_.at(id)));
+        threads_.erase(id);
+      }
+      finished_.clear();
+      freeSlots = config_.workers - static_cast<int>(threads_.size());
+    }
+    for (auto& t : toJoin) t.join();
+    if (freeSlots <= 0) continue;
+    for (auto& job : store_.queued(256)) {
+      if (freeSlots <= 0) break;
+      if (!isRunnable(job)) continue;
+      if (!store_.markStarted(job.id)) continue;  // cancelled meanwhile
+      std::lock_guard lock(mutex_);
+      if (stopping_) {
+        store_.transition(job.id, state::running, state::queued, "server shutting down");
+        return;
+      }
+      const std::uint64_t run = ++runs_;
+      threads_.emplace(run, std::thread(&WorkerPool::runJob, this, job, run));
+      --freeSlots;
+    }
+  }
+}
+
+void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
+  namespace fs = std::filesystem;
+  const fs::path dir = config_.jobDir(job.id);
+  const fs::path log = dir / "solver.log";
+  std::streamoff logStart = 0;
+  int waitStatus = -1;
+  std::string setupError;
+  try {
+    fs::create_directories(dir);
+    auto document = nlohmann::json::parse(job.request);
+    if (!job.databaseRef.empty()) {
+      const DatabaseRef ref = resolveDatabaseRef(store_, config_, job.databaseRef);
+      document["database"] = fs::absolute(ref.path).string();
+    }
+    {
+      std::ofstream out(dir / "job.json.tmp");
+      out << document.dump(2) << "\n";
+      if (!out) throw std::runtime_error("cannot write " + (dir / "job.json").string());
+    }
+    fs::rename(dir / "job.json.tmp", dir / "job.json");
+    if (fs::exists(log)) logStart = static_cast<std::streamoff>(fs::file_size(log));
+  } catch (const std::exception& e) {
+    setupError = std::string("could not prepare the job directory: ") + e.what();
+  }
+
+  int logFd = -1, pipeFds[2] = {-1, -1};
+  pid_t pid = -1;
+  if (setupError.empty()) {
+    logFd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (logFd < 0 || ::pipe2(pipeFds, O_CLOEXEC) != 0)
+      setupError = std::string("cannot open the solver log or pipe: ") + std::strerror(errno);
+  }
+  if (setupError.empty()) {
+    const std::string header = "=== attempt " + std::to_string(job.attempt + 1) + " at " +
+                               nowRfc3339() + " ===\n";
+    (void)!::write(logFd, header.data(), header.size());
+    logStart += static_cast<std::streamoff>(header.size());
+    const std::string solver = config_.solverPath.string();
+    const std::string jobFile = (dir / "job.json").string();
+    const std::string outDir = dir.string();
+    std::vector<const char*> argv = {solver.c_str(), "run", jobFile.c_str(), "--out",
+                                     outDir.c_str(), "--progress-json", nullptr};
+    const pid_t parent = ::getpid();
+    pid = ::fork();
+    if (pid == 0) {
+      // Child: only async-signal-safe calls until exec.
+      ::setpgid(0, 0);                      // a terminal's Ctrl-C reaches the server only
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);   // server gone -> checkpoint and exit 130
+      if (::getppid() != parent) ::_exit(130);
+      const int devnull = ::open("/dev/null", O_RDONLY);
+      ::dup2(devnull, 0);
+      ::dup2(pipeFds[1], 1);
+      ::dup2(logFd, 2);
+      // The solver must not hold the server's sockets (listener, client connections): a connection
+      // it kept open would outlive the server's close or be reset when the solver exits.
+      ::close_range(3, ~0U, 0);
+      ::execv(argv[0], const_cast<char* const*>(argv.data()));
+      const char msg[] = "rcfd-server: cannot execute the solver\n";
+      (void)!::write(2, msg, sizeof msg - 1);
+      ::_exit(127);
+    }
+    ::close(pipeFds[1]);
+    if (pid < 0) {
+      setupError = std::string("fork failed: ") + std::strerror(errno);
+      ::close(pipeFds[0]);
+    }
+  }
+  if (logFd >= 0) ::close(logFd);
+
+  if (setupError.empty()) {
+    {
+      std::lock_guard lock(mutex_);
+      children_[job.id] = pid;
+    }
+    // Cancel or shutdown may have come between markStarted and the fork.
+    if (auto now = store_.job(job.id); now && now->state == state::cancelling) ::kill(pid, SIGTERM);
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) ::kill(pid, SIGTERM);
+    }
+    std::string buffer;
+    char chunk[4096];
+    auto lastWrite = std::chrono::steady_clock::now() - kProgressWriteInterval;
+    nlohmann::json latest;
+    for (;;) {
+      const ssize_t n = ::read(pipeFds[0], chunk, sizeof chunk);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      buffer.append(chunk, static_cast<std::size_t>(n));
+      std::size_t eol;
+      while ((eol = buffer.find('\n')) != std::string::npos) {
+        const std::string line = buffer.substr(0, eol);
+        buffer.erase(0, eol + 1);
+        auto parsed = nlohmann::json::parse(line, nullptr, false);
+        if (parsed.is_object() && parsed.contains("fraction")) latest = std::move(parsed);
+      }
+      const auto now = std::chrono::steady_clock::now();
+      if (!latest.is_null() && now - lastWrite >= kProgressWriteInterval) {
+        store_.updateProgress(job.id, latest.value("fraction", 0.0),
+                              optionalNumber(latest, "sim_time"),
+                              optionalNumber(latest, "wall_time"), optionalNumber(latest, "eta_s"));
+        lastWrite = now;
+        latest = nullptr;
+      }
+    }
+    ::close(pipeFds[0]);
+    if (!latest.is_null())
+      store_.updateProgress(job.id, latest.value("fraction", 0.0), optionalNumber(latest, "sim_time"),
+                            optionalNumber(latest, "wall_time"), optionalNumber(latest, "eta_s"));
+    while (::waitpid(pid, &waitStatus, 0) < 0 && errno == EINTR) {
+    }
+    std::lock_guard lock(mutex_);
+    children_.erase(job.id);
+  }
+
+  if (!setupError.empty()) {
+    if (!store_.transition(job.id, state::running, state::failed, {}, setupError))
+      store_.transition(job.id, state::cancelling, state::cancelled, "cancelled before start");
+  } else {
+    finishJob(job, waitStatus, logTail(log, logStart));
+  }
+  {
+    std::lock_guard lock(mutex_);
+    finished_.push_back(run);
+    pending_ = true;
+  }
+  wake_.notify_all();
+}
+
+void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail) {
+  bool stopping;
+  {
+    std::lock_guard lock(mutex_);
+    stopping = stopping_;
+  }
+  const auto current = store_.job(job.id);
+  const bool cancelling = current && current->state == state::cancelling;
+  const std::string from = cancelling ? state::cancelling : state::running;
+  const auto withTail = [&](std::string reason) {
+    return reasonTail.empty() ? reason : reason + ": " + reasonTail;
+  };
+
+  if (WIFEXITED(waitStatus)) {
+    const int code = WEXITSTATUS(waitStatus);
+    if (code == exit_code::success) {
+      const auto path = config_.jobDir(job.id) / "summary.json";
+      std::ifstream in(path);
+      auto summary = nlohmann::json::parse(in, nullptr, false);
+      if (!in || summary.is_discarded() || !summary.is_object()) {
+        store_.transition(job.id, from, state::failed, {},
+                          "the solver exited 0 but summary.json is missing or not a JSON object");
+        return;
+      }
+      store_.markSucceeded(job.id, summary, coverageBins(summary));
+      return;
+    }
+    if (code == exit_code::cancelled) {
+      if (cancelling)
+        store_.transition(job.id, from, state::cancelled, "the solver checkpointed and stopped");
+      else if (stopping)
+        store_.transition(job.id, from, state::queued,
+                          "server shut down; the job resumes from its checkpoint");
+      else
+        store_.transition(job.id, from, state::failed, {},
+                          withTail("the solver was stopped from outside the server (exit 130)"));
+      return;
+    }
+    std::string what = code == exit_code::invalid_input ? "the solver rejected the job (exit 2)"
+                       : code == exit_code::run_failed  ? "the run failed (exit 3)"
+                       : code == 127 ? "the solver could not be executed (exit 127)"
+                                     : "the solver exited with code " + std::to_string(code);
+    store_.transition(job.id, from, cancelling ? state::cancelled : state::failed, {},
+                      withTail(what));
+    return;
+  }
+  if (WIFSIGNALED(waitStatus)) {
+    const int sig = WTERMSIG(waitStatus);
+    if (stopping && !cancelling && sig == SIGTERM) {
+      store_.transition(job.id, from, state::queued, "server shut down before the solver checkpointed");
+      return;
+    }
+    store_.transition(job.id, from, cancelling ? state::cancelled : state::failed, {},
+                      withTail("the solver was killed by " + signalName(sig)));
+    return;
+  }
+  store_.transition(job.id, from, state::failed, {}, "the solver ended in an unknown way");
+}
+
+void WorkerPool::shutdown() {
+  std::map<std::uint64_t, std::thread> threads;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && !scheduler_.joinable()) return;
+    stopping_ = true;
+    for (const auto& [id, pid] : children_) ::kill(pid, SIGTERM);
+  }
+  wake_.notify_all();
+  if (scheduler_.joinable()) scheduler_.join();
+  // Wait for the solvers to checkpoint; past the grace period, SIGKILL what is left.
+  const auto deadline = std::chrono::steady_clock::now() + config_.shutdownGrace;
+  for (;;) {
+    {
+      std::lock_guard lock(mutex_);
+      if (children_.empty()) break;
+      if (std::chrono::steady_clock::now() > deadline)
+        for (const auto& [id, pid] : children_) ::kill(pid, SIGKILL);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  {
+    std::lock_guard lock(mutex_);
+    threads.swap(threads_);
+    finished_.clear();
+  }
+  for (auto& [id, t] : threads)
+    if (t.joinable()) t.join();
+}
+
+}  // namespace rcfd::server

@@ -1,0 +1,162 @@
+// rcfd-server: the HTTP/JSON job server (CONTRACTS.md, docs/api.md). This file reads the command
+// line, opens the store, starts the worker pool and the listener, and shuts down on SIGINT/SIGTERM:
+// stop accepting, then let running solvers checkpoint (their jobs resume on the next start).
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/thread_pool.hpp>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include "Ids.hpp"
+#include "JobStore.hpp"
+#include "Listener.hpp"
+#include "Metrics.hpp"
+#include "Router.hpp"
+#include "ServerConfig.hpp"
+#include "WorkerPool.hpp"
+
+namespace net = boost::asio;
+using namespace rcfd::server;
+
+namespace {
+
+std::string trim(std::string s) {
+  const auto first = s.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return {};
+  return s.substr(first, s.find_last_not_of(" \t\r\n") - first + 1);
+}
+
+std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read " + path.string());
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// The token from --token-file, else RCFD_TOKEN, else DIR/token (created with a random token).
+std::string resolveToken(const std::string& tokenFile, const std::filesystem::path& dataDir) {
+  if (!tokenFile.empty()) {
+    auto token = trim(readFile(tokenFile));
+    if (token.empty()) throw std::runtime_error("--token-file " + tokenFile + " is empty");
+    return token;
+  }
+  if (const char* env = std::getenv("RCFD_TOKEN"); env && *env) return trim(env);
+  const auto path = dataDir / "token";
+  if (std::filesystem::exists(path)) {
+    auto token = trim(readFile(path));
+    if (!token.empty()) {
+      std::cerr << "rcfd-server: using the token in " << path.string() << "\n";
+      return token;
+    }
+  }
+  const std::string token = newId();
+  {
+    std::ofstream out(path);
+    out << token << "\n";
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+  }
+  ::chmod(path.c_str(), 0600);
+  std::cerr << "rcfd-server: no token configured; generated one in " << path.string()
+            << " (clients: RCFD_TOKEN=$(cat " << path.string() << "))\n";
+  return token;
+}
+
+net::ip::tcp::endpoint parseListen(const std::string& text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) throw std::runtime_error("--listen must be HOST:PORT, got " + text);
+  std::string host = text.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  const int port = std::stoi(text.substr(colon + 1));
+  if (port < 0 || port > 65535) throw std::runtime_error("--listen port must be 0..65535");
+  return {net::ip::make_address(host), static_cast<unsigned short>(port)};
+}
+
+std::filesystem::path defaultSolver() {
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path("rcfd-solve") : self.parent_path() / "rcfd-solve";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rcfd-server: the rcfd job server (REST under /v1, docs/api.md)"};
+  ServerConfig config;
+  std::string dataDir, listen = "127.0.0.1:8080", tokenFile, solver;
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  config.workers = static_cast<int>(std::max(1u, cores / 2));
+  int ioThreads = 2;
+  std::uint64_t maxUpload = config.uploadLimit, maxBody = config.jsonBodyLimit;
+  int graceSeconds = static_cast<int>(config.shutdownGrace.count());
+  app.add_option("--data-dir", dataDir, "directory for rcfd.sqlite, jobs/ and databases/")->required();
+  app.add_option("--listen", listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
+  app.add_option("--token-file", tokenFile, "file holding the bearer token (else RCFD_TOKEN, else DIR/token)");
+  app.add_option("--workers", config.workers, "concurrent solver processes; 0 keeps jobs queued")->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  app.add_option("--solver", solver, "rcfd-solve executable (default: beside rcfd-server)");
+  app.add_option("--io-threads", ioThreads, "threads serving HTTP")->capture_default_str()->check(CLI::Range(1, 64));
+  app.add_option("--max-body-bytes", maxBody, "limit of a JSON request body")->capture_default_str();
+  app.add_option("--max-upload-bytes", maxUpload, "limit of a database upload")->capture_default_str();
+  app.add_option("--shutdown-grace", graceSeconds, "seconds solvers get to checkpoint on shutdown")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    std::signal(SIGPIPE, SIG_IGN);
+    config.dataDir = std::filesystem::absolute(dataDir);
+    std::filesystem::create_directories(config.dataDir / "jobs");
+    std::filesystem::create_directories(config.databaseDir());
+    config.token = resolveToken(tokenFile, config.dataDir);
+    config.solverPath = solver.empty() ? defaultSolver() : std::filesystem::absolute(solver);
+    config.jsonBodyLimit = maxBody;
+    config.uploadLimit = maxUpload;
+    config.shutdownGrace = std::chrono::seconds(graceSeconds);
+    if (config.workers > 0 && ::access(config.solverPath.c_str(), X_OK) != 0)
+      std::cerr << "rcfd-server: warning: solver " << config.solverPath.string()
+                << " is not executable; jobs will fail (use --solver)\n";
+
+    JobStore store((config.dataDir / "rcfd.sqlite").string());
+    WorkerPool pool(store, config);
+    Metrics metrics;
+    Router router(store, pool, metrics, config);
+    net::io_context ioc(ioThreads);
+    net::thread_pool blocking(2);
+    auto listener = std::make_shared<Listener>(ioc, parseListen(listen), router, blocking);
+    // Signals are caught before the listening line is printed, so a supervisor that reads it can
+    // always stop the server gracefully.
+    net::signal_set signals(ioc, SIGINT, SIGTERM);
+    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      std::cerr << "rcfd-server: signal " << sig
+                << ": stopping; running solvers checkpoint and resume on the next start\n";
+      listener->stop();
+      ioc.stop();
+    });
+    const auto bound = listener->endpoint();
+    const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]"
+                                                     : bound.address().to_string();
+    std::cout << "listening on http://" << host << ":" << bound.port() << std::endl;
+    std::cerr << "rcfd-server: data " << config.dataDir.string() << ", " << config.workers
+              << " worker slot(s), solver " << config.solverPath.string() << "\n";
+    pool.start();
+    listener->run();
+
+    std::vector<std::thread> threads;
+    for (int i = 1; i < ioThreads; ++i) threads.emplace_back([&ioc] { ioc.run(); });
+    ioc.run();
+    for (auto& t : threads) t.join();
+    pool.shutdown();
+    blocking.join();
+    std::cerr << "rcfd-server: stopped\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "rcfd-server: error: " << e.what() << "\n";
+    return 1;
+  }
+}

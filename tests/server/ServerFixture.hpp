@@ -1,0 +1,198 @@
+#pragma once
+// Test helpers: start a real rcfd-server (from RCFD_BINARY_DIR) on 127.0.0.1:0 with a temporary data
+// directory, and talk to it over real HTTP (Boost.Beast, one connection per request).
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace rcfd::test {
+
+inline std::filesystem::path binaryDir() { return RCFD_BINARY_DIR; }
+inline std::filesystem::path sourceDir() { return RCFD_SOURCE_DIR; }
+
+/// A fresh directory under the system temp dir, removed by the destructor.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("rcfd-server-test-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct Reply {
+  int status = 0;
+  std::map<std::string, std::string> headers;  // lower-case names
+  std::string body;
+  nlohmann::json json() const { return nlohmann::json::parse(body); }
+  std::string header(const std::string& name) const {
+    auto it = headers.find(name);
+    return it == headers.end() ? std::string() : it->second;
+  }
+};
+
+/// One HTTP exchange on a new connection.
+inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, const std::string& target,
+                         const std::string& token = {}, const std::string& body = {},
+                         const std::map<std::string, std::string>& headers = {}) {
+  namespace http = boost::beast::http;
+  boost::asio::io_context ioc;
+  boost::beast::tcp_stream stream(ioc);
+  stream.connect(boost::asio::ip::tcp::endpoint(boost::asio::ip::make_address("127.0.0.1"), port));
+  http::request<http::string_body> req{method, target, 11};
+  req.set(http::field::host, "127.0.0.1");
+  if (!token.empty()) req.set(http::field::authorization, "Bearer " + token);
+  for (const auto& [k, v] : headers) req.set(k, v);
+  if (!body.empty() || method == http::verb::post) {
+    req.set(http::field::content_type, "application/json");
+    req.body() = body;
+  }
+  req.prepare_payload();
+  boost::beast::error_code writeEc, readEc;
+  http::write(stream, req, writeEc);  // the server may answer early (413) and stop reading
+  boost::beast::flat_buffer buffer;
+  http::response_parser<http::string_body> parser;
+  parser.body_limit(1ull << 30);
+  http::read(stream, buffer, parser, readEc);
+  if (readEc) throw std::runtime_error("http read failed: " + readEc.message());
+  Reply r;
+  r.status = parser.get().result_int();
+  for (const auto& f : parser.get()) {
+    std::string name(f.name_string());
+    for (auto& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    r.headers[name] = std::string(f.value());
+  }
+  r.body = parser.get().body();
+  return r;
+}
+
+/// A running rcfd-server child process.
+class ServerProcess {
+ public:
+  ServerProcess(const std::filesystem::path& dataDir, std::string token,
+                std::vector<std::string> extraArgs = {"--workers", "0"})
+      : dataDir_(dataDir), token_(std::move(token)) {
+    const auto binary = binaryDir() / "rcfd-server";
+    const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
+    {
+      std::ofstream out(tokenFile);
+      out << token_ << "\n";
+    }
+    std::vector<std::string> args = {binary.string(), "--data-dir", dataDir.string(), "--listen",
+                                     "127.0.0.1:0", "--token-file", tokenFile.string()};
+    args.insert(args.end(), extraArgs.begin(), extraArgs.end());
+    int out[2];
+    if (::pipe(out) != 0) throw std::runtime_error("pipe");
+    stderrPath_ = dataDir.parent_path() / (dataDir.filename().string() + ".stderr");
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(out[1], 1);
+      const int err = ::open(stderrPath_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      ::dup2(err, 2);
+      ::close(out[0]);
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+    ::close(out[1]);
+    // First stdout line: "listening on http://127.0.0.1:PORT".
+    std::string line;
+    char c;
+    while (::read(out[0], &c, 1) == 1 && c != '\n') line.push_back(c);
+    ::close(out[0]);
+    firstLine_ = line;
+    const auto colon = line.rfind(':');
+    if (line.rfind("listening on http://", 0) != 0 || colon == std::string::npos)
+      throw std::runtime_error("rcfd-server did not start: \"" + line + "\"; stderr: " + stderrText());
+    port_ = static_cast<unsigned short>(std::stoi(line.substr(colon + 1)));
+  }
+  ~ServerProcess() {
+    if (pid_ > 0) stop(SIGTERM);
+  }
+  ServerProcess(const ServerProcess&) = delete;
+  ServerProcess& operator=(const ServerProcess&) = delete;
+
+  /// Sends `sig` and waits; returns the wait status.
+  int stop(int sig) {
+    int status = 0;
+    if (pid_ <= 0) return status;
+    ::kill(pid_, sig);
+    ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return status;
+  }
+  bool alive() const { return pid_ > 0 && ::kill(pid_, 0) == 0; }
+
+  unsigned short port() const { return port_; }
+  pid_t pid() const { return pid_; }
+  const std::string& token() const { return token_; }
+  const std::string& firstLine() const { return firstLine_; }
+  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
+  std::string stderrText() const {
+    std::ifstream in(stderrPath_);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+  Reply get(const std::string& target) const {
+    return httpRequest(port_, boost::beast::http::verb::get, target, token_);
+  }
+  Reply post(const std::string& target, const std::string& body,
+             const std::map<std::string, std::string>& headers = {}) const {
+    return httpRequest(port_, boost::beast::http::verb::post, target, token_, body, headers);
+  }
+
+ private:
+  std::filesystem::path dataDir_, stderrPath_;
+  std::string token_, firstLine_;
+  pid_t pid_ = -1;
+  unsigned short port_ = 0;
+};
+
+/// The scene of examples/quick.json (a scene, or a job file holding one inline or via scene_file).
+inline nlohmann::json quickScene() {
+  const auto path = sourceDir() / "examples" / "quick.json";
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("missing " + path.string());
+  auto doc = nlohmann::json::parse(in);
+  if (doc.contains("scene")) return doc["scene"];
+  if (doc.contains("scene_file")) {
+    std::ifstream s(path.parent_path() / doc["scene_file"].get<std::string>());
+    return nlohmann::json::parse(s);
+  }
+  return doc;
+}
+
+/// A valid database job (seed varies the body, so each is a distinct request).
+inline nlohmann::json databaseJob(int seed = 1) {
+  return {{"kind", "database"}, {"scene", quickScene()}, {"seed", seed}};
+}
+
+}  // namespace rcfd::test

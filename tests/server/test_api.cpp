@@ -1,0 +1,270 @@
+// The REST API against a real rcfd-server on loopback: auth, every kind of bad request with its 4xx
+// and problem+json body, idempotent submit, pagination, cancel, metrics. Workers are 0, so jobs stay
+// QUEUED and no solver runs.
+
+#include <gtest/gtest.h>
+
+#include "ServerFixture.hpp"
+
+using namespace rcfd::test;
+namespace http = boost::beast::http;
+
+namespace {
+
+class Api : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    data_ = std::make_unique<TempDir>();
+    server_ = std::make_unique<ServerProcess>(data_->path() / "data", "test-token-123");
+  }
+  /// After any bad request the server must still answer.
+  void expectStillServing() {
+    const auto health = httpRequest(server_->port(), http::verb::get, "/v1/health");
+    EXPECT_EQ(health.status, 200);
+  }
+  static void expectProblem(const Reply& r, int status) {
+    EXPECT_EQ(r.status, status) << r.body;
+    EXPECT_EQ(r.header("content-type"), "application/problem+json");
+    const auto p = r.json();
+    EXPECT_EQ(p.at("status").get<int>(), status);
+    EXPECT_FALSE(p.at("title").get<std::string>().empty());
+    EXPECT_TRUE(p.contains("type"));
+    EXPECT_TRUE(p.contains("detail"));
+    EXPECT_TRUE(p.contains("instance"));
+  }
+  std::unique_ptr<TempDir> data_;
+  std::unique_ptr<ServerProcess> server_;
+};
+
+TEST_F(Api, PrintsListeningLineAndServesHealthWithoutToken) {
+  EXPECT_EQ(server_->firstLine(), server_->url().insert(0, "listening on "));
+  const auto r = httpRequest(server_->port(), http::verb::get, "/v1/health");
+  ASSERT_EQ(r.status, 200);
+  EXPECT_EQ(r.json().at("status"), "ok");
+}
+
+TEST_F(Api, MissingOrWrongTokenIs401WithChallenge) {
+  const auto missing = httpRequest(server_->port(), http::verb::get, "/v1/jobs");
+  expectProblem(missing, 401);
+  EXPECT_EQ(missing.header("www-authenticate"), "Bearer realm=\"rcfd\"");
+  const auto wrong = httpRequest(server_->port(), http::verb::get, "/v1/jobs", "test-token-124");
+  expectProblem(wrong, 401);
+  const auto metrics = httpRequest(server_->port(), http::verb::get, "/metrics", "nope");
+  expectProblem(metrics, 401);
+  EXPECT_EQ(server_->get("/v1/jobs").status, 200);
+  expectStillServing();
+}
+
+TEST_F(Api, InvalidJsonIs400) {
+  const auto r = server_->post("/v1/jobs", "{\"kind\": \"spray\",");
+  expectProblem(r, 400);
+  EXPECT_NE(r.json().at("detail").get<std::string>().find("JSON"), std::string::npos);
+  expectStillServing();
+}
+
+TEST_F(Api, SchemaViolationIs422WithPointer) {
+  auto job = databaseJob();
+  job["kind"] = "teleport";
+  const auto r = server_->post("/v1/jobs", job.dump());
+  expectProblem(r, 422);
+  bool found = false;
+  const auto body = r.json();
+  for (const auto& e : body.at("errors")) found = found || e.at("pointer") == "/kind";
+  EXPECT_TRUE(found) << r.body;
+
+  auto unknown = databaseJob();
+  unknown["colour"] = "blue";  // unknown keys are errors (CONTRACTS.md)
+  const auto r2 = server_->post("/v1/jobs", unknown.dump());
+  expectProblem(r2, 422);
+  expectStillServing();
+}
+
+TEST_F(Api, SceneFileIsRefusedByTheServer) {
+  auto job = databaseJob();
+  job.erase("scene");
+  job["scene_file"] = "/etc/passwd";
+  const auto r = server_->post("/v1/jobs", job.dump());
+  expectProblem(r, 422);
+  EXPECT_EQ(r.json().at("errors").at(0).at("pointer"), "/scene_file");
+}
+
+TEST_F(Api, UnknownOrFailedDatabaseReferenceIs422) {
+  nlohmann::json spray = {{"kind", "spray"}, {"scene", quickScene()},
+                          {"database", "0123456789abcdef0123456789abcdef"}, {"duration", 1.0}};
+  const auto r = server_->post("/v1/jobs", spray.dump());
+  expectProblem(r, 422);
+  bool found = false;
+  const auto body = r.json();
+  for (const auto& e : body.at("errors")) found = found || e.at("pointer") == "/database";
+  EXPECT_TRUE(found) << r.body;
+
+  // A cancelled database job cannot serve as a database either.
+  const auto db = server_->post("/v1/jobs", databaseJob(7).dump()).json();
+  ASSERT_EQ(server_->post("/v1/jobs/" + db.at("id").get<std::string>() + ":cancel", "").status, 200);
+  spray["database"] = db.at("id");
+  expectProblem(server_->post("/v1/jobs", spray.dump()), 422);
+}
+
+TEST_F(Api, SprayOnAQueuedDatabaseJobIsAcceptedAndWaits) {
+  const std::string db = server_->post("/v1/jobs", databaseJob(9).dump()).json().at("id");
+  const nlohmann::json spray = {{"kind", "spray"}, {"scene", quickScene()}, {"database", db},
+                                {"duration", 1.0}};
+  const auto r = server_->post("/v1/jobs", spray.dump());
+  ASSERT_EQ(r.status, 202) << r.body;
+  EXPECT_EQ(r.json().at("database"), db);
+  EXPECT_EQ(r.json().at("state"), "QUEUED");
+  // A spray job without a database is refused.
+  auto none = spray;
+  none.erase("database");
+  expectProblem(server_->post("/v1/jobs", none.dump()), 422);
+}
+
+TEST_F(Api, OversizeBodyIs413) {
+  const std::string big(2u << 20, ' ');  // 2 MiB of whitespace, over the 1 MiB JSON limit
+  const auto r = server_->post("/v1/jobs", big);
+  expectProblem(r, 413);
+  expectStillServing();
+}
+
+TEST_F(Api, UnknownJobIs404) {
+  const std::string id = "00000000000000000000000000000000";
+  expectProblem(server_->get("/v1/jobs/" + id), 404);
+  expectProblem(server_->get("/v1/jobs/" + id + "/result"), 404);
+  expectProblem(server_->post("/v1/jobs/" + id + ":cancel", ""), 404);
+  expectProblem(server_->get("/v1/nothing-here"), 404);
+  expectStillServing();
+}
+
+TEST_F(Api, ArtifactPathsAreRefused) {
+  const auto job = server_->post("/v1/jobs", databaseJob().dump()).json();
+  const std::string base = "/v1/jobs/" + job.at("id").get<std::string>() + "/artifacts/";
+  for (const std::string name : {"../../rcfd.sqlite", "..%2F..%2Frcfd.sqlite", "..", "token",
+                                 "rcfd.sqlite", "%2e%2e%2ftoken", "x/../../token"}) {
+    const auto r = server_->get(base + name);
+    EXPECT_TRUE(r.status == 400 || r.status == 404) << name << " -> " << r.status;
+    EXPECT_EQ(r.header("content-type"), "application/problem+json") << name;
+    EXPECT_EQ(r.body.find("test-token-123"), std::string::npos);
+  }
+  // A valid name the job has not produced yet is 404.
+  expectProblem(server_->get(base + "result.h5"), 404);
+  expectStillServing();
+}
+
+TEST_F(Api, SubmitAnswers202WithLocationAndRetryAfter) {
+  const auto r = server_->post("/v1/jobs", databaseJob().dump());
+  ASSERT_EQ(r.status, 202) << r.body;
+  const auto job = r.json();
+  const std::string id = job.at("id");
+  EXPECT_EQ(id.size(), 32u);
+  EXPECT_EQ(r.header("location"), "/v1/jobs/" + id);
+  EXPECT_FALSE(r.header("retry-after").empty());
+  EXPECT_EQ(job.at("state"), "QUEUED");
+  const auto got = server_->get("/v1/jobs/" + id).json();
+  EXPECT_EQ(got.at("kind"), "database");
+  EXPECT_EQ(got.at("state"), "QUEUED");
+  // A result does not exist before the job succeeded.
+  expectProblem(server_->get("/v1/jobs/" + id + "/result"), 409);
+  expectProblem(server_->get("/v1/jobs/" + id + "/coverage?format=csv"), 409);
+}
+
+TEST_F(Api, IdempotencyKeyReturnsSameJobAndRefusesDifferentBody) {
+  const std::map<std::string, std::string> key = {{"Idempotency-Key", "retry-42"}};
+  const auto first = server_->post("/v1/jobs", databaseJob(1).dump(), key);
+  const auto second = server_->post("/v1/jobs", databaseJob(1).dump(), key);
+  ASSERT_EQ(first.status, 202);
+  ASSERT_EQ(second.status, 202);
+  EXPECT_EQ(first.json().at("id"), second.json().at("id"));
+  const auto all = server_->get("/v1/jobs").json();
+  EXPECT_EQ(all.at("jobs").size(), 1u);
+  const auto different = server_->post("/v1/jobs", databaseJob(2).dump(), key);
+  expectProblem(different, 422);
+  EXPECT_EQ(server_->get("/v1/jobs").json().at("jobs").size(), 1u);
+}
+
+TEST_F(Api, PaginatesTwentyFiveJobsInPagesOfTen) {
+  std::vector<std::string> submitted;
+  for (int i = 0; i < 25; ++i) {
+    const auto r = server_->post("/v1/jobs", databaseJob(i).dump());
+    ASSERT_EQ(r.status, 202);
+    submitted.push_back(r.json().at("id"));
+  }
+  std::vector<std::string> seen;
+  std::string token;
+  int pages = 0;
+  for (;;) {
+    const auto page =
+        server_->get("/v1/jobs?page_size=10" + (token.empty() ? "" : "&page_token=" + token)).json();
+    ++pages;
+    for (const auto& j : page.at("jobs")) seen.push_back(j.at("id"));
+    if (!page.contains("next_page_token")) {
+      EXPECT_EQ(page.at("jobs").size(), 5u);
+      break;
+    }
+    EXPECT_EQ(page.at("jobs").size(), 10u);
+    token = page.at("next_page_token");
+    ASSERT_LT(pages, 5);
+  }
+  EXPECT_EQ(pages, 3);
+  EXPECT_EQ(seen, submitted);  // every job once, in submission order
+  // A token used with other filters, or a forged one, is refused.
+  expectProblem(server_->get("/v1/jobs?page_size=10&state=RUNNING&page_token=" + token), 400);
+  expectProblem(server_->get("/v1/jobs?page_token=garbage!"), 400);
+  expectProblem(server_->get("/v1/jobs?page_size=0"), 400);
+  expectProblem(server_->get("/v1/jobs?state=DONE"), 400);
+}
+
+TEST_F(Api, FiltersByStateAndKind) {
+  const auto a = server_->post("/v1/jobs", databaseJob(1).dump()).json();
+  server_->post("/v1/jobs", databaseJob(2).dump());
+  server_->post("/v1/jobs/" + a.at("id").get<std::string>() + ":cancel", "");
+  const auto cancelled = server_->get("/v1/jobs?state=CANCELLED").json().at("jobs");
+  ASSERT_EQ(cancelled.size(), 1u);
+  EXPECT_EQ(cancelled[0].at("id"), a.at("id"));
+  EXPECT_EQ(server_->get("/v1/jobs?state=QUEUED").json().at("jobs").size(), 1u);
+  EXPECT_EQ(server_->get("/v1/jobs?kind=database").json().at("jobs").size(), 2u);
+  EXPECT_EQ(server_->get("/v1/jobs?kind=spray").json().at("jobs").size(), 0u);
+}
+
+TEST_F(Api, CancelQueuedJobAtOnceAndRecordsEvents) {
+  const std::string id = server_->post("/v1/jobs", databaseJob().dump()).json().at("id");
+  const auto r = server_->post("/v1/jobs/" + id + ":cancel", "");
+  ASSERT_EQ(r.status, 200) << r.body;
+  EXPECT_EQ(r.json().at("state"), "CANCELLED");
+  EXPECT_FALSE(r.json().at("finished_at").is_null());
+  // Cancelling a finished job is a conflict.
+  expectProblem(server_->post("/v1/jobs/" + id + ":cancel", ""), 409);
+  const auto events = server_->get("/v1/jobs/" + id + "/events").json().at("events");
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].at("to"), "QUEUED");
+  EXPECT_EQ(events[1].at("from"), "QUEUED");
+  EXPECT_EQ(events[1].at("to"), "CANCELLED");
+}
+
+TEST_F(Api, MetricsExposeJobGaugesAndLatencyHistogram) {
+  server_->post("/v1/jobs", databaseJob(1).dump());
+  server_->post("/v1/jobs", databaseJob(2).dump());
+  const auto r = server_->get("/metrics");
+  ASSERT_EQ(r.status, 200);
+  EXPECT_NE(r.header("content-type").find("text/plain"), std::string::npos);
+  EXPECT_NE(r.body.find("rcfd_jobs{state=\"QUEUED\"} 2"), std::string::npos) << r.body;
+  EXPECT_NE(r.body.find("rcfd_jobs{state=\"SUCCEEDED\"} 0"), std::string::npos);
+  EXPECT_NE(r.body.find("rcfd_queue_length 2"), std::string::npos);
+  EXPECT_NE(r.body.find("rcfd_http_request_duration_seconds_bucket{le=\"+Inf\"}"), std::string::npos);
+  EXPECT_NE(r.body.find("rcfd_http_requests_total{code=\"2xx\"}"), std::string::npos);
+}
+
+TEST_F(Api, ServesEmbeddedSchemas) {
+  const auto job = server_->get("/v1/schemas/job");
+  ASSERT_EQ(job.status, 200);
+  EXPECT_NO_THROW((void)job.json());
+  EXPECT_EQ(server_->get("/v1/schemas/scene").status, 200);
+  expectProblem(server_->get("/v1/schemas/nothing"), 404);
+}
+
+TEST_F(Api, WrongMethodIs405WithAllow) {
+  const auto r = httpRequest(server_->port(), http::verb::delete_, "/v1/jobs", server_->token());
+  expectProblem(r, 405);
+  EXPECT_EQ(r.header("allow"), "GET, POST");
+}
+
+}  // namespace

@@ -1,0 +1,137 @@
+// The `rcfd` client against a real server (workers 0: jobs stay QUEUED): submit with scene_file
+// inlining and Idempotency-Key, jobs, status, cancel, and the messages and exit codes of errors.
+
+#include <gtest/gtest.h>
+
+#include "ServerFixture.hpp"
+
+using namespace rcfd::test;
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out, err;
+};
+
+/// Runs build/rcfd with arguments and extra environment; captures stdout and stderr.
+Run runClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
+  const auto bin = (binaryDir() / "rcfd").string();
+  args.insert(args.begin(), bin);
+  TempDir capture;
+  const auto outPath = capture.path() / "out", errPath = capture.path() / "err";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::unsetenv("RCFD_SERVER");
+    ::unsetenv("RCFD_TOKEN");
+    for (const auto& e : env) ::putenv(const_cast<char*>(e.c_str()));
+    const int out = ::open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, 1);
+    ::dup2(err, 2);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  Run r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream o(outPath), e(errPath);
+  r.out.assign(std::istreambuf_iterator<char>(o), {});
+  r.err.assign(std::istreambuf_iterator<char>(e), {});
+  return r;
+}
+
+std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
+
+class Client : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tmp_ = std::make_unique<TempDir>();
+    server_ = std::make_unique<ServerProcess>(tmp_->path() / "data", "client-token");
+    // A job file referring to its scene by path, as users write them.
+    std::ofstream(tmp_->path() / "scene.json") << quickScene().dump(2);
+    std::ofstream(tmp_->path() / "job.json")
+        << nlohmann::json{{"kind", "database"}, {"scene_file", "scene.json"}, {"seed", 3}}.dump(2);
+  }
+  std::vector<std::string> env() const {
+    return {"RCFD_SERVER=" + server_->url(), "RCFD_TOKEN=client-token"};
+  }
+  std::unique_ptr<TempDir> tmp_;
+  std::unique_ptr<ServerProcess> server_;
+};
+
+TEST_F(Client, SubmitStatusJobsCancel) {
+  const auto submit = runClient({"submit", (tmp_->path() / "job.json").string()}, env());
+  ASSERT_EQ(submit.code, 0) << submit.err;
+  const std::string id = firstLine(submit.out);
+  ASSERT_EQ(id.size(), 32u) << submit.out;
+  // The server received the scene inline.
+  const auto stored = server_->get("/v1/jobs/" + id + "?view=full").json();
+  EXPECT_EQ(stored.at("request").at("scene"), quickScene());
+  EXPECT_FALSE(stored.at("request").contains("scene_file"));
+
+  const auto status = runClient({"status", id}, env());
+  EXPECT_EQ(status.code, 0) << status.err;
+  EXPECT_NE(status.out.find("state:     QUEUED"), std::string::npos) << status.out;
+
+  const auto jobs = runClient({"jobs", "--state", "QUEUED"}, env());
+  EXPECT_EQ(jobs.code, 0);
+  EXPECT_NE(jobs.out.find(id), std::string::npos);
+
+  const auto cancel = runClient({"cancel", id}, env());
+  EXPECT_EQ(cancel.code, 0) << cancel.err;
+  EXPECT_NE(cancel.out.find("CANCELLED"), std::string::npos);
+  EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "CANCELLED");
+  // Waiting on a cancelled job ends at once with exit 1 and says why.
+  const auto wait = runClient({"wait", id}, env());
+  EXPECT_EQ(wait.code, 1);
+  EXPECT_NE(wait.err.find("CANCELLED"), std::string::npos);
+}
+
+TEST_F(Client, FlagsOverrideEnvironmentAndIdempotencyKeyIsSent) {
+  const std::vector<std::string> flags = {"--server", server_->url(), "--token", "client-token"};
+  auto args = flags;
+  args.insert(args.end(), {"submit", (tmp_->path() / "job.json").string(), "--idempotency-key", "k1"});
+  const auto a = runClient(args, {"RCFD_SERVER=http://127.0.0.1:1", "RCFD_TOKEN=wrong"});
+  const auto b = runClient(args, {"RCFD_SERVER=http://127.0.0.1:1", "RCFD_TOKEN=wrong"});
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_EQ(firstLine(a.out), firstLine(b.out));
+  EXPECT_EQ(server_->get("/v1/jobs").json().at("jobs").size(), 1u);
+}
+
+TEST_F(Client, ErrorsAreExplainedWithExitCodes) {
+  // Bad token: 401, exit 1, a hint about the token.
+  auto bad = runClient({"jobs"}, {"RCFD_SERVER=" + server_->url(), "RCFD_TOKEN=nope"});
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find("401"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("token"), std::string::npos);
+  // Invalid job: 422, exit 2, the pointer printed.
+  std::ofstream(tmp_->path() / "bad.json")
+      << nlohmann::json{{"kind", "teleport"}, {"scene", quickScene()}}.dump();
+  auto invalid = runClient({"submit", (tmp_->path() / "bad.json").string()}, env());
+  EXPECT_EQ(invalid.code, 2);
+  EXPECT_NE(invalid.err.find("/kind"), std::string::npos) << invalid.err;
+  // Unknown job: 404, exit 1.
+  auto missing = runClient({"status", "00000000000000000000000000000000"}, env());
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("404"), std::string::npos);
+  // No server: exit 1 with a hint.
+  auto down = runClient({"jobs"}, {"RCFD_SERVER=http://127.0.0.1:1", "RCFD_TOKEN=x"});
+  EXPECT_EQ(down.code, 1);
+  EXPECT_NE(down.err.find("cannot connect"), std::string::npos) << down.err;
+  // Usage error: exit 2.
+  EXPECT_EQ(runClient({"coverage", "abc", "--format", "xml", "-o", "x"}, env()).code, 2);
+  // Missing scene_file: exit 2 naming the pointer.
+  std::ofstream(tmp_->path() / "noscene.json")
+      << nlohmann::json{{"kind", "database"}, {"scene_file", "absent.json"}}.dump();
+  auto noscene = runClient({"submit", (tmp_->path() / "noscene.json").string()}, env());
+  EXPECT_EQ(noscene.code, 2);
+  EXPECT_NE(noscene.err.find("/scene_file"), std::string::npos);
+}
+
+}  // namespace
