@@ -109,7 +109,7 @@ class CalibrationJob final : public JobRunner {
     std::atomic<bool> stop{false};
     std::mutex mutex;  // progress reporter and the first error
     std::exception_ptr error;
-    ProgressReporter progress(options.progressJson, options.progressInterval, "calibration");
+    ProgressReporter progress(options.progressJson, options.progressInterval, "calibration ");
     progress.setPriorWallTime(priorWall);
     const double totalSteps = double(steps) * double(n);
 
@@ -153,7 +153,7 @@ class CalibrationJob final : public JobRunner {
         }
         if (sim.currentStep() % checkpointEvery == 0 && sim.currentStep() < steps) sim.saveCheckpoint(checkpoint);
         if (mutex.try_lock()) {
-          progress.report(double(stepsDone) / totalSteps, sim.time());
+          progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt);  // summed over D0
           mutex.unlock();
         }
       }
@@ -203,7 +203,7 @@ class CalibrationJob final : public JobRunner {
       writeFileAtomically(runsDir + "/prior_wall_time_s", std::to_string(wall) + "\n");
       throw Cancelled("calibration stopped; finished D0 runs and checkpoints are kept in " + runsDir);
     }
-    progress.report(1.0, double(steps) * scene.rcfd.dt, true);
+    progress.report(1.0, totalSteps * scene.rcfd.dt, true);
 
     // --- scores, selection, result.h5 and figures ---
     analysis::CalibrationInputs inputs{scene, *rec.database, d0, runsDir, reference, selection, steps, discardSteps};
