@@ -1,0 +1,103 @@
+#include "analysis/CalibrationSelection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <stdexcept>
+
+#include "core/Errors.hpp"
+
+namespace rcfd::analysis {
+namespace {
+
+std::string g3(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+double option(const nlohmann::json& c, const char* key, double fallback, double lo, double hi, bool loOpen) {
+  if (!c.contains(key)) return fallback;
+  const std::string pointer = std::string("/calibration/") + key;
+  const auto& v = c.at(key);
+  if (!v.is_number()) throw InputError("job", pointer, "must be a number");
+  const double x = v.get<double>();
+  const bool ok = std::isfinite(x) && (loOpen ? x > lo : x >= lo) && x <= hi;
+  if (!ok) {
+    throw InputError("job", pointer, g3(x) + " is outside " + (loOpen ? "(" : "[") + g3(lo) + ", " + g3(hi) + "]");
+  }
+  return x;
+}
+
+}  // namespace
+
+SelectionOptions selectionOptionsFrom(const nlohmann::json& job) {
+  SelectionOptions o;
+  if (!job.is_object() || !job.contains("calibration")) return o;
+  const auto& c = job.at("calibration");
+  if (!c.is_object()) throw InputError("job", "/calibration", "must be an object");
+  o.fieldRmsTolerance = option(c, "field_rms_tolerance", o.fieldRmsTolerance, 0.0, 10.0, false);
+  o.ksThreshold = option(c, "ks_threshold", o.ksThreshold, 0.0, 1.0, true);
+  o.rtdRelativeTolerance = option(c, "rtd_relative_tolerance", o.rtdRelativeTolerance, 0.0, 10.0, true);
+  return o;
+}
+
+Selection selectD0(const std::vector<D0Scores>& s, const SelectionOptions& o, bool useReference) {
+  if (s.empty()) throw std::invalid_argument("selectD0: no scores");
+  const std::size_t n = s.size();
+  // Visit D0 values in ascending order (the job file may list them in any order).
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s[a].d0 < s[b].d0; });
+
+  Selection sel;
+  sel.penaltyMinimum = order[0];
+  std::size_t bestField = order[0];
+  for (const std::size_t i : order) {
+    if (s[i].penalty < s[sel.penaltyMinimum].penalty) sel.penaltyMinimum = i;
+    if (s[i].fieldRms < s[bestField].fieldRms) bestField = i;
+  }
+  const double fieldLimit = (1.0 + o.fieldRmsTolerance) * s[bestField].fieldRms;
+  const double rtdTarget = s[bestField].rtdMean;
+  sel.bedShapeAgrees.assign(n, false);
+  sel.residenceTimesAgree.assign(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    sel.bedShapeAgrees[i] = s[i].fieldRms <= fieldLimit;
+    if (s[i].stays == 0) continue;  // no completed stay: no residence-time distribution to compare
+    if (useReference) {
+      sel.residenceTimesAgree[i] = s[i].ksDistance && *s[i].ksDistance <= o.ksThreshold;
+    } else {
+      sel.residenceTimesAgree[i] = rtdTarget > 0.0 && std::abs(s[i].rtdMean - rtdTarget) <= o.rtdRelativeTolerance * rtdTarget;
+    }
+  }
+  const std::string bed = "bed shape (field RMS difference within " + g3(100.0 * o.fieldRmsTolerance) +
+                          "% of the best, " + g3(s[bestField].fieldRms) + ")";
+  const std::string rtd = useReference ? "residence times (KS distance to the reference <= " + g3(o.ksThreshold) + ")"
+                                       : "residence times (mean within " + g3(100.0 * o.rtdRelativeTolerance) +
+                                             "% of the best-shaped run's " + g3(rtdTarget) +
+                                             " s; no reference RTD)";
+  const std::string penalty = "; the penalty minimum is at D0 = " + g3(s[sel.penaltyMinimum].d0) + " m2/s";
+  for (const std::size_t i : order) {
+    if (sel.bedShapeAgrees[i] && sel.residenceTimesAgree[i]) {
+      sel.selected = i;
+      sel.ruleSatisfied = true;
+      sel.reason = "D0 = " + g3(s[i].d0) + " m2/s is the lowest value whose " + bed + " and " + rtd +
+                   " agree (field RMS " + g3(s[i].fieldRms) +
+                   (s[i].ksDistance ? ", KS " + g3(*s[i].ksDistance) : std::string()) +
+                   ", mean residence time " + g3(s[i].rtdMean) + " s)" + penalty;
+      return sel;
+    }
+  }
+  for (const std::size_t i : order) {
+    if (sel.bedShapeAgrees[i]) {
+      sel.selected = i;
+      sel.reason = "no D0 met both criteria; D0 = " + g3(s[i].d0) + " m2/s is the lowest whose " + bed +
+                   " agrees, but no value met the " + rtd + " criterion" + penalty;
+      break;
+    }
+  }
+  return sel;
+}
+
+}  // namespace rcfd::analysis

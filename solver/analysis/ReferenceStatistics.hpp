@@ -1,0 +1,34 @@
+#pragma once
+/// \file ReferenceStatistics.hpp
+/// Spray-zone statistics of the full CFD-DEM simulation, stored by the database job in the field
+/// database file (layout in docs/calibration.md). Optional: an imported database has none, and the
+/// calibration then reports which scores it could not compute.
+
+#include <string>
+#include <vector>
+
+namespace rcfd::analysis {
+
+namespace reference_layout {
+inline constexpr const char* durations = "/reference/residence_time/durations_s";  ///< float64 [M]
+inline constexpr const char* holdup = "/reference/holdup/particles";               ///< float64 [T], attr dt
+inline constexpr const char* holdupDt = "dt";                                      ///< [s]
+}  // namespace reference_layout
+
+struct ReferenceStatistics {
+  std::vector<double> durations;  ///< completed spray-zone stays [s]; empty if absent
+  std::vector<double> holdup;     ///< spray-zone holdup series [particles]; empty if absent
+  double holdupDt = 0.0;          ///< [s] between holdup samples
+  std::vector<std::string> missing;  ///< datasets not found (their names from reference_layout)
+
+  bool hasDurations() const { return !durations.empty(); }
+  bool hasHoldup() const { return !holdup.empty(); }
+  double holdupMean() const;
+};
+
+/// Reads the reference statistics of a database file. Absent datasets go into `missing`; present but
+/// malformed ones (non-finite or negative values, empty, missing or non-positive dt) are an
+/// rcfd::InputError naming the file and dataset.
+ReferenceStatistics readReferenceStatistics(const std::string& databasePath);
+
+}  // namespace rcfd::analysis

@@ -1,0 +1,254 @@
+// The "calibration" job (the paper's section "Reproduction of bed distribution and dynamics in rCFD"):
+// one tracer run per D0 value on one shared recurrence path, scored against the recurrence fields
+// (probe penalty, time-averaged alpha_P) and, when the database carries them, the full simulation's
+// spray-zone holdup and residence times; then the penalty minimum and the paper's choice of D0.
+// Finished D0 runs live in DIR/runs/d0_<i>/ (result.h5, summary.json); a re-run skips them and resumes
+// an interrupted one from its checkpoint. Aggregation: analysis/CalibrationReport.cpp.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <spdlog/spdlog.h>
+#include <thread>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "analysis/CalibrationReport.hpp"
+#include "analysis/CalibrationSelection.hpp"
+#include "analysis/ReferenceStatistics.hpp"
+#include "core/Errors.hpp"
+#include "jobs/Cancellation.hpp"
+#include "jobs/JobRunner.hpp"
+#include "jobs/Progress.hpp"
+#include "jobs/RecurrenceSetup.hpp"
+#include "tracers/TracerSimulation.hpp"
+
+namespace rcfd {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The paper's range of D0 values [m2/s], used when the job gives none.
+const std::vector<double> kDefaultD0 = {0.0, 1e-5, 1e-4, 5e-4, 1e-3, 1e-2};
+/// Effects of every calibration run, whatever the scene lists.
+const std::vector<std::string> kCalibrationEffects = {"transport", "fluctuation",   "free_flight",
+                                                      "walls",     "tracer_volume_fraction", "probes",
+                                                      "residence_time", "field_average"};
+
+int threadBudget() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+void setRunThreads(int n) {
+#ifdef _OPENMP
+  omp_set_num_threads(n);  // per-thread setting: applies to parallel regions this thread starts
+#else
+  (void)n;
+#endif
+}
+
+nlohmann::json readJson(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+enum class RunOutcome { Finished, Stopped };
+
+class CalibrationJob final : public JobRunner {
+ public:
+  nlohmann::json run(const JobSpec& job, const RunOptions& options) override {
+    const auto wallStart = std::chrono::steady_clock::now();
+    const Scene& scene = job.scene;
+    if (job.database.empty()) throw InputError("job", "/database", "a calibration job needs a database");
+    const std::int64_t steps = std::llround(job.duration / scene.rcfd.dt);
+    if (steps < 1) throw InputError("job", "/duration", "shorter than one time step rcfd.dt");
+    const std::int64_t discardSteps = std::llround(job.discard / scene.rcfd.dt);
+    if (!(job.discard >= 0.0) || discardSteps >= steps) {
+      throw InputError("job", "/discard", std::to_string(job.discard) + " s must be >= 0 and shorter than /duration (" +
+                                              std::to_string(job.duration) + " s)");
+    }
+    if (scene.probes.empty()) {
+      throw InputError("job", "/scene/probes", "a calibration needs at least one probe for the penalty score");
+    }
+    const std::vector<double> d0 = job.d0_values.empty() ? kDefaultD0 : job.d0_values;
+    std::set<double> seen;
+    for (std::size_t i = 0; i < d0.size(); ++i) {
+      const std::string pointer = "/d0_values/" + std::to_string(i);
+      if (!std::isfinite(d0[i]) || d0[i] < 0.0) throw InputError("job", pointer, "D0 must be finite and >= 0 m2/s");
+      if (!seen.insert(d0[i]).second) throw InputError("job", pointer, "repeats an earlier D0 value");
+    }
+    const analysis::SelectionOptions selection = analysis::selectionOptionsFrom(job.source);
+    const bool parallelOverD0 = parallelMode(job.source) == "d0_values";
+
+    // Reference statistics first: the recurrence setup may rewrite the file (stored matrix).
+    const analysis::ReferenceStatistics reference = analysis::readReferenceStatistics(job.database);
+    for (const auto& m : reference.missing) {
+      spdlog::warn("{}: no {} (reference statistics of the full simulation); scores that need it are not computed",
+                   job.database, m);
+    }
+    // One path for every D0 (the paper used a precomputed path to remove path randomness).
+    const RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed);
+
+    const std::string runsDir = options.outDir + "/runs";
+    fs::create_directories(runsDir);
+    double priorWall = 0.0;
+    if (fs::exists(runsDir + "/prior_wall_time_s")) std::ifstream(runsDir + "/prior_wall_time_s") >> priorWall;
+
+    // --- the D0 runs ---
+    const std::size_t n = d0.size();
+    std::atomic<std::int64_t> stepsThisProcess{0}, stepsDone{0};
+    std::atomic<bool> stop{false};
+    std::mutex mutex;  // progress reporter and the first error
+    std::exception_ptr error;
+    ProgressReporter progress(options.progressJson, options.progressInterval, "calibration ");
+    progress.setPriorWallTime(priorWall);
+    const double totalSteps = double(steps) * double(n);
+
+    auto runOne = [&](std::size_t i) -> RunOutcome {
+      const std::string dir = runsDir + "/d0_" + std::to_string(i);
+      const nlohmann::json key = {{"d0", d0[i]},          {"seed", job.seed},       {"steps", steps},
+                                  {"discard_steps", discardSteps}, {"tracers", scene.rcfd.tracers},
+                                  {"dt", scene.rcfd.dt},  {"database", job.database}};
+      if (fs::exists(dir + "/key.json") && readJson(dir + "/key.json") != key) {
+        spdlog::warn("{} holds a run of other settings; starting D0 = {} afresh", dir, d0[i]);
+        fs::remove_all(dir);
+      }
+      if (fs::exists(dir + "/summary.json")) {
+        stepsDone += steps;
+        return RunOutcome::Finished;  // finished by an earlier process
+      }
+      fs::create_directories(dir);
+      writeFileAtomically(dir + "/key.json", key.dump() + "\n");
+
+      Scene s = scene;
+      s.rcfd.d0 = d0[i];
+      s.effects = kCalibrationEffects;
+      TracerSimulation sim(s, rec.database, rec.path, TracerRunSettings{job.seed, steps, discardSteps});
+      const std::string checkpoint = dir + "/checkpoint.h5";
+      if (fs::exists(checkpoint)) {
+        sim.loadCheckpoint(checkpoint);
+        spdlog::info("D0 = {}: resumed at step {} of {}", d0[i], sim.currentStep(), steps);
+      }
+      stepsDone += sim.currentStep();
+      const std::int64_t checkpointEvery =
+          std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / scene.rcfd.dt));
+      while (sim.currentStep() < steps) {
+        sim.step();
+        ++stepsDone;
+        const std::int64_t done = ++stepsThisProcess;
+        if (options.stopAfterSteps >= 0 && done >= options.stopAfterSteps) stop = true;
+        if (stop || cancellationRequested()) {
+          stop = true;
+          sim.saveCheckpoint(checkpoint);
+          return RunOutcome::Stopped;
+        }
+        if (sim.currentStep() % checkpointEvery == 0 && sim.currentStep() < steps) sim.saveCheckpoint(checkpoint);
+        if (mutex.try_lock()) {
+          progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt);  // summed over D0
+          mutex.unlock();
+        }
+      }
+      nlohmann::json summary = {{"d0", d0[i]}, {"key", key}};
+      {
+        h5::File out(dir + "/result.h5.tmp", h5::File::Mode::Create);
+        sim.writeResults(out, summary);
+        out.flush();
+      }
+      fs::rename(dir + "/result.h5.tmp", dir + "/result.h5");
+      writeFileAtomically(dir + "/summary.json", summary.dump(2) + "\n");
+      fs::remove(checkpoint);
+      spdlog::info("D0 = {} m2/s: penalty {:.4g}", d0[i], summary["probes"]["penalty_mean"].get<double>());
+      return RunOutcome::Finished;
+    };
+    auto guarded = [&](std::size_t i) {
+      try {
+        runOne(i);
+      } catch (...) {
+        std::lock_guard lock(mutex);
+        if (!error) error = std::current_exception();
+        stop = true;
+      }
+    };
+
+    const int budget = std::max(1, threadBudget());
+    const int workers = parallelOverD0 ? int(std::min<std::size_t>(std::size_t(budget), n)) : 1;
+    const int threadsPerRun = std::max(1, budget / workers);
+    spdlog::info("calibration: {} D0 values x {} steps; {} run(s) at a time with {} thread(s) each", n, steps,
+                 workers, threadsPerRun);
+    if (workers <= 1) {
+      for (std::size_t i = 0; i < n && !stop; ++i) guarded(i);
+    } else {
+      std::atomic<std::size_t> next{0};
+      std::vector<std::thread> pool;
+      for (int w = 0; w < workers; ++w) {
+        pool.emplace_back([&] {
+          setRunThreads(threadsPerRun);
+          for (std::size_t i = next++; i < n && !stop; i = next++) guarded(i);
+        });
+      }
+      for (auto& t : pool) t.join();
+    }
+    const double wall = priorWall + progress.wallTime();
+    if (error) std::rethrow_exception(error);
+    if (stop) {
+      writeFileAtomically(runsDir + "/prior_wall_time_s", std::to_string(wall) + "\n");
+      throw Cancelled("calibration stopped; finished D0 runs and checkpoints are kept in " + runsDir);
+    }
+    progress.report(1.0, totalSteps * scene.rcfd.dt, true);
+
+    // --- scores, selection, result.h5 and figures ---
+    analysis::CalibrationInputs inputs{scene, *rec.database, d0, runsDir, reference, selection, steps, discardSteps};
+    nlohmann::json summary = analysis::writeCalibrationReport(inputs, options.outDir + "/result.h5",
+                                                             scene.outputs.svg ? options.outDir : std::string());
+    {
+      h5::File out(options.outDir + "/result.h5", h5::File::Mode::ReadWrite);
+      out.write("/path/frames", std::vector<std::int64_t>(rec.path.frames.begin(), rec.path.frames.end()));
+    }
+    summary["kind"] = job.kind;
+    summary["status"] = "succeeded";
+    summary["seed"] = job.seed;
+    summary["steps"] = steps;  // per D0
+    summary["sim_time_s"] = double(steps) * scene.rcfd.dt;
+    summary["discard_s"] = double(discardSteps) * scene.rcfd.dt;
+    summary["dt"] = scene.rcfd.dt;
+    summary["tracers"] = scene.rcfd.tracers;
+    summary["effects"] = kCalibrationEffects;
+    summary["path"] = {{"jumps", rec.pathStats.jumps},
+                       {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},
+                       {"mean_sequence_frames", rec.pathStats.meanSequenceLength}};
+    // Wall time describes this machine, not the physics: the only key allowed to differ between
+    // otherwise bit-identical runs.
+    summary["wall_time_s"] = priorWall + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    fs::remove(runsDir + "/prior_wall_time_s");
+    return summary;
+  }
+
+ private:
+  static std::string parallelMode(const nlohmann::json& document) {
+    const std::string fallback = "d0_values";
+    if (!document.is_object() || !document.contains("calibration")) return fallback;
+    const auto& c = document["calibration"];
+    if (!c.is_object() || !c.contains("parallel")) return fallback;
+    const auto& v = c["parallel"];
+    if (!v.is_string() || (v != "d0_values" && v != "tracers")) {
+      throw InputError("job", "/calibration/parallel", "must be \"d0_values\" or \"tracers\"");
+    }
+    return v.get<std::string>();
+  }
+};
+
+const bool registered = JobRunnerRegistry::add(
+    "calibration", "rCFD tracer runs for each D0 scored against the recurrence fields and the full simulation",
+    [] { return std::make_unique<CalibrationJob>(); });
+
+}  // namespace
+}  // namespace rcfd

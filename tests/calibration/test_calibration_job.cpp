@@ -1,0 +1,335 @@
+// The calibration job end to end on an analytic box database: the tracers start over-packed in one
+// half (frame 0), all later frames are uniform, so relaxation (D0 > 0) is what brings the tracer
+// alpha_P to the recurrence alpha_P. Checks the penalty ordering, the summary, determinism, thread
+// independence, missing and present reference statistics, and resume after an interruption.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "../tracers/TracerTestSupport.hpp"
+#include "analysis/ReferenceStatistics.hpp"
+#include "core/Errors.hpp"
+#include "jobs/JobRunner.hpp"
+#include "recurrence/PathFile.hpp"
+
+using namespace rcfd;
+using namespace rcfd::test;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kDt = 0.005;
+constexpr int kFrames = 50;
+constexpr std::int64_t kSteps = 300;
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rcfd-test-calibration-" + std::to_string(::getpid())) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+Scene calibrationScene(const fs::path& pathFile) {
+  Scene s = boxScene({0.02, 0.02, 0.01}, 0.005, 2000, kDt, {"transport"}, 0.25);
+  s.rcfd.path.type = "file";
+  s.rcfd.path.file = pathFile.string();
+  s.probes = {{"left", Vec3(-0.0075, 0.0075, 0.0025)},
+              {"centre", Vec3(0.0025, 0.0125, 0.0075)},
+              {"right", Vec3(0.0075, 0.0075, 0.0025)}};
+  // A slab-like spray zone around x = 0: a cone with a far-away apex and a narrow half-angle.
+  s.spray.spray_zone.apex = Vec3(0.0, -10.0, 0.005);
+  s.spray.spray_zone.half_angle_deg = 0.03;
+  s.spray.spray_zone.y_min = 0.0;
+  s.spray.spray_zone.y_max = 0.02;
+  s.outputs.residence_time_bins = 20;
+  s.source_json = "{\"test\": \"calibration box\"}";
+  return s;
+}
+
+/// Writes the database (frame 0: the bed in the left half; then uniform 0.25, at rest) and the path
+/// file (frame 0 once, then frames 1..49 cycling) into dir; returns the job.
+JobSpec makeJob(const fs::path& dir, std::vector<double> d0 = {0.0, 1e-3, 1e-2}) {
+  const fs::path pathFile = dir / "path.txt";
+  RecurrencePath path;
+  path.frames.push_back(0);
+  for (int k = 1; k < kSteps + 10; ++k) path.frames.push_back(1 + (k - 1) % (kFrames - 1));
+  writePathFile(pathFile.string(), path);
+  JobSpec job;
+  job.kind = "calibration";
+  job.scene = calibrationScene(pathFile);
+  const CartesianGrid grid = gridOf(job.scene);
+  Apparatus a(job.scene.apparatus);
+  const auto open = openFractions(a, grid);
+  writeAnalyticDatabase((dir / "db.h5").string(), grid, std::vector<float>(open.begin(), open.end()), kDt, kFrames,
+                        [&](int n, double, FieldFrame& f) {
+                          for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+                            const auto ijk = grid.cellIjk(c);
+                            f.alpha_p[std::size_t(c)] = n == 0 ? (ijk[0] < 2 ? 0.5f : 0.0f) : 0.25f;
+                          }
+                        });
+  job.database = (dir / "db.h5").string();
+  job.duration = double(kSteps) * kDt;
+  job.discard = 0.5;
+  job.seed = 5;
+  job.checkpoint_interval = 0.5;
+  job.d0_values = std::move(d0);
+  job.source = json::object();
+  return job;
+}
+
+json run(const JobSpec& job, const fs::path& out, long stopAfter = -1) {
+  RunOptions o;
+  o.outDir = out.string();
+  o.stopAfterSteps = stopAfter;
+  return runJob(job, o);
+}
+
+json withoutWallTime(json s) {
+  s.erase("wall_time_s");
+  return s;
+}
+
+/// Every numeric dataset of a calibration result.h5 (by name), for bit-for-bit comparisons.
+std::vector<std::string> resultDatasets(std::size_t runs) {
+  std::vector<std::string> names = {"/calibration/d0", "/calibration/penalty", "/calibration/rms",
+                                    "/calibration/field_rms_difference", "/calibration/field_rms_difference_midplane",
+                                    "/calibration/holdup_mean", "/calibration/residence_time_mean_s",
+                                    "/calibration/residence_time_median_s", "/calibration/rtd_edges",
+                                    "/calibration/recurrence/alpha_p_midplane", "/path/frames"};
+  for (std::size_t i = 0; i < runs; ++i) {
+    const std::string g = "/calibration/runs/d0_" + std::to_string(i);
+    for (const char* d : {"/probes/time", "/probes/alpha_p_tracers", "/probes/alpha_p_recurrence", "/holdup/particles",
+                          "/residence_time/duration_steps_counts", "/residence_time/density",
+                          "/field_average/alpha_p_midplane"}) {
+      names.push_back(g + d);
+    }
+  }
+  return names;
+}
+
+void expectSameResults(const fs::path& a, const fs::path& b, std::size_t runs) {
+  h5::File fa((a / "result.h5").string(), h5::File::Mode::ReadOnly);
+  h5::File fb((b / "result.h5").string(), h5::File::Mode::ReadOnly);
+  for (const auto& name : resultDatasets(runs)) {
+    ASSERT_TRUE(fa.exists(name)) << name;
+    ASSERT_TRUE(fb.exists(name)) << name;
+    const auto va = fa.readDoubles(name), vb = fb.readDoubles(name);
+    ASSERT_EQ(va.size(), vb.size()) << name;
+    EXPECT_EQ(0, std::memcmp(va.data(), vb.data(), va.size() * sizeof(double))) << name;
+  }
+}
+
+void setThreads(int n) {
+#ifdef _OPENMP
+  omp_set_num_threads(n);
+#else
+  (void)n;
+#endif
+}
+
+}  // namespace
+
+TEST(CalibrationJob, RelaxationLowersThePenaltyAndEveryD0IsReported) {
+  const fs::path dir = scratch("basic");
+  const JobSpec job = makeJob(dir);
+  const json s = run(job, dir / "out");
+  EXPECT_EQ(s["kind"], "calibration");
+  EXPECT_EQ(s["status"], "succeeded");
+  ASSERT_EQ(s["d0"].size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(s["d0"][i]["value"].get<double>(), job.d0_values[i]);
+    for (const char* key : {"penalty", "holdup_mean", "residence_time_mean_s", "field_rms_difference"}) {
+      EXPECT_TRUE(s["d0"][i][key].is_number()) << key;
+    }
+  }
+  const double selected = s["selected_d0"].get<double>();
+  std::size_t sel = 0;
+  while (sel < 3 && job.d0_values[sel] != selected) ++sel;
+  ASSERT_LT(sel, 3u) << "selected_d0 " << selected << " is not one of the values";
+  EXPECT_GT(selected, 0.0);
+  EXPECT_GT(s["d0"][0]["penalty"].get<double>(), s["d0"][sel]["penalty"].get<double>());
+  // Without relaxation the bed keeps its frame-0 shape: the field error is far above the relaxed one.
+  EXPECT_GT(s["d0"][0]["field_rms_difference"].get<double>(), 2.0 * s["d0"][sel]["field_rms_difference"].get<double>());
+  EXPECT_EQ(s["d0"][0]["stays"].get<long>(), 0) << "nothing moves at D0 = 0";
+  EXPECT_GT(s["d0"][2]["stays"].get<long>(), 0);
+  EXPECT_TRUE(s["penalty_minimum_d0"].is_number());
+  EXPECT_FALSE(s["selection_reason"].get<std::string>().empty());
+  EXPECT_EQ(s["effects"].size(), 8u);
+  // Outputs: result.h5 datasets, the figures, summary.json on disk.
+  h5::File r((dir / "out/result.h5").string(), h5::File::Mode::ReadOnly);
+  EXPECT_EQ(r.readDoubles("/calibration/d0"), job.d0_values);
+  EXPECT_EQ(r.doubleAttribute("/calibration", "selected_d0"), selected);
+  EXPECT_EQ(r.shape("/calibration/runs/d0_1/probes/alpha_p_tracers")[1], 3u);
+  EXPECT_EQ(r.readDoubles("/calibration/runs/d0_1/holdup/particles").size(), std::size_t(kSteps - 100));
+  for (const auto& f : s["figures"]) EXPECT_TRUE(fs::exists(dir / "out" / f.get<std::string>())) << f;
+  EXPECT_EQ(s["figures"].size(), 5u);
+  EXPECT_TRUE(fs::exists(dir / "out/summary.json"));
+}
+
+TEST(CalibrationJob, MissingReferenceIsReportedNotFatal) {
+  const fs::path dir = scratch("noref");
+  const json s = run(makeJob(dir), dir / "out");
+  const json& ref = s["reference"];
+  EXPECT_FALSE(ref["available"].get<bool>());
+  EXPECT_EQ(ref["missing"], json({"/reference/residence_time/durations_s", "/reference/holdup/particles"}));
+  EXPECT_EQ(ref["scores_not_computed"], json({"rtd_ks_distance", "holdup_relative_error"}));
+  for (const auto& d : s["d0"]) {
+    EXPECT_TRUE(d["rtd_ks_distance"].is_null());
+    EXPECT_TRUE(d["holdup_relative_error"].is_null());
+  }
+  EXPECT_EQ(s["selection"]["residence_times_judged_by"], "mean_relative_tolerance");
+}
+
+TEST(CalibrationJob, ReferenceStatisticsAreUsed) {
+  // The reference is the D0 = 1e-2 run's own RTD and holdup: that run must score KS = 0 and a zero
+  // holdup error, the frozen D0 = 0 run (no stays) no KS distance at all.
+  const fs::path dir = scratch("ref");
+  JobSpec job = makeJob(dir);
+  const json first = run(job, dir / "first");
+  std::vector<double> durations, holdup;
+  {
+    h5::File r((dir / "first/result.h5").string(), h5::File::Mode::ReadOnly);
+    const auto counts = r.readInt64s("/calibration/runs/d0_2/residence_time/duration_steps_counts");
+    for (std::size_t k = 0; k < counts.size(); ++k)
+      for (std::int64_t c = 0; c < counts[k]; ++c) durations.push_back(double(k) * kDt);
+    holdup = r.readDoubles("/calibration/runs/d0_2/holdup/particles");
+  }
+  ASSERT_FALSE(durations.empty());
+  {
+    h5::File db(job.database, h5::File::Mode::ReadWrite);
+    db.write(analysis::reference_layout::durations, durations);
+    db.write(analysis::reference_layout::holdup, holdup);
+    db.setAttribute(analysis::reference_layout::holdup, "dt", kDt);
+  }
+  const json s = run(job, dir / "second");
+  EXPECT_TRUE(s["reference"]["available"].get<bool>());
+  EXPECT_TRUE(s["reference"]["scores_not_computed"].empty());
+  EXPECT_EQ(s["selection"]["residence_times_judged_by"], "ks_distance_to_reference");
+  EXPECT_TRUE(s["d0"][0]["rtd_ks_distance"].is_null());
+  EXPECT_EQ(s["d0"][2]["rtd_ks_distance"].get<double>(), 0.0);
+  EXPECT_NEAR(s["d0"][2]["holdup_relative_error"].get<double>(), 0.0, 1e-12);
+  ASSERT_TRUE(s["d0"][1]["rtd_ks_distance"].is_number());
+  EXPECT_GT(s["d0"][1]["rtd_ks_distance"].get<double>(), 0.0);
+  EXPECT_LE(s["d0"][1]["rtd_ks_distance"].get<double>(), 1.0);
+  EXPECT_NEAR(s["reference"]["residence_time_mean_s"].get<double>(), s["d0"][2]["residence_time_mean_s"].get<double>(),
+              1e-12);
+  // The scores not depending on the reference are those of the run without it.
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(s["d0"][i]["penalty"], first["d0"][i]["penalty"]);
+}
+
+TEST(CalibrationJob, BadReferenceIsAnInputErrorNamingTheDataset) {
+  const fs::path dir = scratch("badref");
+  JobSpec job = makeJob(dir, {0.0, 1e-2});
+  {
+    h5::File db(job.database, h5::File::Mode::ReadWrite);
+    db.write(analysis::reference_layout::holdup, std::vector<double>{1.0, 2.0});  // no dt attribute
+  }
+  try {
+    run(job, dir / "out");
+    FAIL() << "accepted a holdup series without dt";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/reference/holdup/particles@dt"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CalibrationJob, SameSeedSameResult) {
+  const fs::path dir = scratch("determinism");
+  JobSpec job = makeJob(dir);
+  const json first = run(job, dir / "first");
+  const json again = run(job, dir / "again");
+  EXPECT_EQ(withoutWallTime(first), withoutWallTime(again));
+  expectSameResults(dir / "first", dir / "again", 3);
+  job.seed = 6;
+  EXPECT_NE(run(job, dir / "other-seed")["d0"], first["d0"]) << "the seed must matter";
+}
+
+TEST(CalibrationJob, ThreadCountAndParallelModeDoNotMatter) {
+  // More tracers than kParallelThreshold, so the tracer loops really run on 2 threads in "tracers"
+  // mode; a shorter run keeps the test fast on a loaded machine.
+  const fs::path dir = scratch("threads");
+  JobSpec job = makeJob(dir, {0.0, 1e-2});
+  job.scene.rcfd.tracers = 5000;
+  job.duration = 60 * kDt;
+  job.discard = 20 * kDt;
+  setThreads(1);
+  const json one = run(job, dir / "one");
+  setThreads(2);
+  const json two = run(job, dir / "two");
+  job.source = {{"calibration", {{"parallel", "tracers"}}}};
+  const json tracers = run(job, dir / "tracers");
+  EXPECT_EQ(withoutWallTime(one), withoutWallTime(two));
+  EXPECT_EQ(withoutWallTime(two), withoutWallTime(tracers));
+  expectSameResults(dir / "one", dir / "two", 2);
+  expectSameResults(dir / "two", dir / "tracers", 2);
+}
+
+TEST(CalibrationJob, ResumeAfterInterruptionEqualsAnUninterruptedRun) {
+  const fs::path dir = scratch("resume");
+  JobSpec job = makeJob(dir);
+  const json reference = run(job, dir / "whole");
+
+  // One D0 at a time: the first run finishes, the second stops 37 steps in.
+  job.source = {{"calibration", {{"parallel", "tracers"}}}};
+  EXPECT_THROW(run(job, dir / "split", kSteps + 37), Cancelled);
+  EXPECT_TRUE(fs::exists(dir / "split/runs/d0_0/summary.json"));
+  EXPECT_TRUE(fs::exists(dir / "split/runs/d0_1/checkpoint.h5"));
+  EXPECT_FALSE(fs::exists(dir / "split/runs/d0_2"));
+  EXPECT_FALSE(fs::exists(dir / "split/summary.json"));
+  const auto finishedAt = fs::last_write_time(dir / "split/runs/d0_0/result.h5");
+  const json resumed = run(job, dir / "split");
+  EXPECT_EQ(fs::last_write_time(dir / "split/runs/d0_0/result.h5"), finishedAt) << "a finished D0 was run again";
+  EXPECT_FALSE(fs::exists(dir / "split/runs/d0_1/checkpoint.h5"));
+  EXPECT_EQ(withoutWallTime(resumed), withoutWallTime(reference));
+  expectSameResults(dir / "whole", dir / "split", 3);
+
+  // Several D0 at once, interrupted twice.
+  job.source = json::object();
+  EXPECT_THROW(run(job, dir / "parallel", 40), Cancelled);
+  EXPECT_THROW(run(job, dir / "parallel", 200), Cancelled);
+  EXPECT_EQ(withoutWallTime(run(job, dir / "parallel")), withoutWallTime(reference));
+  expectSameResults(dir / "whole", dir / "parallel", 3);
+}
+
+TEST(CalibrationJob, BadInputNamesTheField) {
+  const fs::path dir = scratch("bad");
+  JobSpec job = makeJob(dir, {0.0, 1e-3, 1e-3});
+  auto pointerOf = [&](const JobSpec& j) -> std::string {
+    try {
+      run(j, dir / "out");
+    } catch (const InputError& e) {
+      return e.violations().at(0).pointer;
+    }
+    return "(accepted)";
+  };
+  EXPECT_EQ(pointerOf(job), "/d0_values/2");
+  job.d0_values = {0.0, 1e-3};
+  job.discard = job.duration;
+  EXPECT_EQ(pointerOf(job), "/discard");
+  job.discard = 0.5;
+  job.scene.probes.clear();
+  EXPECT_EQ(pointerOf(job), "/scene/probes");
+}
+
+// Not part of the suite: times the two ways of sharing the threads (run with
+// --gtest_also_run_disabled_tests --gtest_filter='*Timing*'; numbers in docs/calibration.md).
+TEST(CalibrationJob, DISABLED_TimingOfParallelModes) {
+  const fs::path dir = scratch("timing");
+  JobSpec job = makeJob(dir, {0.0, 1e-5, 1e-4, 5e-4, 1e-3, 1e-2});
+  job.scene.rcfd.tracers = 20000;  // the quick scene's tracer count
+  for (const char* mode : {"d0_values", "tracers", "d0_values", "tracers"}) {
+    job.source = {{"calibration", {{"parallel", mode}}}};
+    const auto start = std::chrono::steady_clock::now();
+    run(job, dir / mode);
+    fs::remove_all(dir / mode);
+    std::printf("parallel = %-9s: %.3f s wall\n", mode,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+}
