@@ -285,13 +285,15 @@ TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
   EXPECT_EQ(server->get("/v1/health").status, 200);
 }
 
+// Jobs of 12 simulated seconds (~5 s of wall time on an idle machine): long enough that the test sees
+// them RUNNING before they finish (2 s jobs finished within one progress interval when the machine was idle).
 TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   std::string db, interrupted;
   pid_t solver = -1;
   {
     auto server = start(1);
     db = upload(*server);
-    interrupted = submit(*server, sprayJob(db, 2.0, 5));
+    interrupted = submit(*server, sprayJob(db, 12.0, 5));
     const auto running = pollJob(*server, interrupted, [](const nlohmann::json& j) {
       return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0.1;
     });
@@ -312,7 +314,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   const auto resumed = pollJob(*server, interrupted, isFinal, std::chrono::seconds(90));
   ASSERT_EQ(resumed.at("state"), "SUCCEEDED") << resumed.dump(2);
   EXPECT_EQ(resumed.at("attempt"), 2);
-  const std::string reference = submit(*server, sprayJob(db, 2.0, 5));
+  const std::string reference = submit(*server, sprayJob(db, 12.0, 5));
   ASSERT_EQ(pollJob(*server, reference, isFinal, std::chrono::seconds(90)).at("state"), "SUCCEEDED");
   const auto a = server->get("/v1/jobs/" + interrupted + "/result").json();
   const auto b = server->get("/v1/jobs/" + reference + "/result").json();
@@ -330,7 +332,7 @@ TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   {
     auto server = start(1);
     const std::string db = upload(*server);
-    id = submit(*server, sprayJob(db, 2.0, 4));
+    id = submit(*server, sprayJob(db, 12.0, 4));
     const auto running = pollJob(*server, id, [](const nlohmann::json& j) {
       return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0;
     });
