@@ -1,0 +1,104 @@
+#pragma once
+/// \file CfdDemSimulation.hpp
+/// The built-in coarse-grained CFD-DEM of a scene: the DEM (DemSystem), the gas phase (gas::GasSolver,
+/// only when the scene lists the effect `gas`) and their coupling (particle volume mapped to the grid,
+/// optional smoothing by Eq. (3), Beetstra drag and the pressure-gradient force, momentum exchange
+/// back to the gas). One coupling step is one gas step of a whole number of DEM steps, so simulated
+/// time is an integer count of DEM steps and never drifts.
+///
+/// This is the interface the database job (jobs/DatabaseJob.cpp) drives; the coupling itself lives in
+/// cfddem/coupling/. Fields are per grid cell in the field database's order (x fastest).
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cfddem/DemFilling.hpp"
+#include "cfddem/DemSystem.hpp"
+#include "geometry/Apparatus.hpp"
+#include "geometry/CartesianGrid.hpp"
+#include "scene/Scene.hpp"
+
+namespace rcfd {
+
+namespace h5 {
+class File;
+}
+namespace gas {
+class GasSolver;
+}
+
+/// Figures of the last coupling step.
+struct CfdDemStepStats {
+  double dt = 0.0;          ///< gas step = demSteps * dt_DEM [s]
+  int demSteps = 0;         ///< DEM sub-steps in this coupling step
+  int pressureIterations = 0;
+  double courant = 0.0;     ///< gas Courant number after the step [-]
+  double maxAlphaP = 0.0;   ///< largest particle volume fraction of a cell [-]
+};
+
+class CfdDemSimulation {
+ public:
+  /// Builds apparatus, grid, DEM (walls, contact and rolling models of the scene) and, when the scene
+  /// lists `gas`, the gas solver and coupling (`drag`, `smoothing` select their stages). Throws
+  /// InputError naming the scene field on an inconsistent set-up.
+  CfdDemSimulation(const Scene& scene, std::uint64_t seed);
+  ~CfdDemSimulation();
+
+  /// Inserts the scene's bed mass as parcels and lets it settle (DEM only, gas off), at most
+  /// scene.dem.settle_time. Deterministic for the seed.
+  FillResult fillAndSettle();
+
+  /// Scales the inlet and nozzle flows by factor in [0, 1] (the database job ramps the gas up).
+  void setFlowFactor(double factor);
+
+  /// Advances by one coupling step: at most scene.dem.coupling_interval DEM steps, fewer when the gas
+  /// CFL limit asks for it, and never past `untilDemStep` (so sampling instants are hit exactly).
+  /// Without `gas` it runs DEM steps only. Throws RunError on a non-finite state.
+  const CfdDemStepStats& step(std::int64_t untilDemStep);
+
+  std::int64_t demStep() const;   ///< DEM steps since construction (the clock)
+  double time() const;            ///< demStep() * dt_DEM [s]
+  double demTimeStep() const;
+
+  const Scene& scene() const { return scene_; }
+  const Apparatus& apparatus() const { return *apparatus_; }
+  const CartesianGrid& grid() const { return grid_; }
+  const DemSystem& dem() const { return *dem_; }
+  DemSystem& dem() { return *dem_; }
+  bool hasGas() const { return gas_ != nullptr; }
+  const gas::GasSolver* gasSolver() const { return gas_.get(); }
+
+  /// alpha_P per cell as the coupling sees it (after smoothing when enabled) [-]; computed from the
+  /// current particles on demand when the gas is off.
+  std::vector<double> particleFraction() const;
+  /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
+  std::vector<Eigen::Vector3d> particleVelocity() const;
+  /// Gas velocity at cell centres, zero in closed cells and without gas [m/s].
+  std::vector<Eigen::Vector3d> gasVelocity() const;
+  /// Bed pressure drop: inlet minus outlet pressure [Pa]; 0 without gas.
+  double pressureDrop() const;
+
+  /// Whole state (particles, contact history where kept, gas, clock) into / from a checkpoint group.
+  void saveState(h5::File& file, const std::string& group) const;
+  void loadState(const h5::File& file, const std::string& group);
+
+  const CfdDemStepStats& lastStep() const { return last_; }
+
+ private:
+  struct Coupling;  // volume mapping, drag, exchange (cfddem/coupling/)
+
+  const Scene& scene_;
+  std::uint64_t seed_;
+  std::unique_ptr<Apparatus> apparatus_;
+  CartesianGrid grid_;
+  std::unique_ptr<DemSystem> dem_;
+  std::unique_ptr<gas::GasSolver> gas_;
+  std::unique_ptr<Coupling> coupling_;
+  CfdDemStepStats last_;
+  std::int64_t demStep_ = 0;
+};
+
+}  // namespace rcfd
