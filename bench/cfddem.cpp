@@ -5,7 +5,8 @@
 // the gas, the mean DEM sub-steps per gas step and the largest alpha_P.
 //   --quick: ramp 0.02 s, 0.02 s timed.   Full: ramp 0.1 s, 0.2 s timed.
 //   RCFD_BENCH_CFDDEM_SECONDS=T: time T s instead; RCFD_BENCH_CFDDEM_RAMP=R: ramp R s;
-//   RCFD_BENCH_CFDDEM_SCENE=path: another scene file;
+//   RCFD_BENCH_CFDDEM_SCENE=path: another scene file; RCFD_BENCH_CFDDEM_SAVE=path: the final state
+//   into a checkpoint; RCFD_BENCH_CFDDEM_START=path: start from such a checkpoint (no fill, no ramp);
 //   RCFD_BENCH_CFDDEM_PGM=prefix: also writes alpha_P (mean over z) as prefix-N.pgm every 0.2 s and
 //   prefix-alpha.pgm at the end. A progress line every 0.05 s simulated goes to stderr.
 #include <chrono>
@@ -67,10 +68,16 @@ nlohmann::json runCfdDem(const Options& o) {
     h5::File f(cache.string(), h5::File::Mode::Create);
     sim.saveState(f, "/state");
   }
+  // A developed state (saved by an earlier run with RCFD_BENCH_CFDDEM_SAVE) replaces fill and ramp.
+  const char* startPath = std::getenv("RCFD_BENCH_CFDDEM_START");
+  if (startPath) {
+    h5::File f(startPath, h5::File::Mode::ReadOnly);
+    sim.loadState(f, "/state");
+  }
   const std::size_t parcels = sim.dem().particles().size();
   const std::int64_t stepsPerSecond = std::llround(1.0 / sim.demTimeStep());
   // Ramp (untimed), as the database job does.
-  const std::int64_t rampEnd = sim.demStep() + std::llround(ramp * stepsPerSecond);
+  const std::int64_t rampEnd = sim.demStep() + (startPath ? 0 : std::llround(ramp * stepsPerSecond));
   while (sim.demStep() < rampEnd) {
     const double f = std::min(1.0, 1.0 - double(rampEnd - sim.demStep()) / (ramp * stepsPerSecond));
     sim.setFlowFactor(std::max(0.0, f));
@@ -133,6 +140,10 @@ nlohmann::json runCfdDem(const Options& o) {
             << " DEM steps per gas step, DEM share " << demWall / wall << ", max alpha_P " << maxAlphaP
             << ", pressure drop " << sim.pressureDrop() << " Pa\n";
   if (pgm) writeAlphaImage(sim, std::string(pgm) + "-alpha.pgm");
+  if (const char* save = std::getenv("RCFD_BENCH_CFDDEM_SAVE")) {
+    h5::File f(save, h5::File::Mode::Create);
+    sim.saveState(f, "/state");
+  }
   return out;
 }
 

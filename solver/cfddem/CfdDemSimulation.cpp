@@ -58,6 +58,7 @@ FillResult CfdDemSimulation::fillAndSettle() {
   options.max_settle_time = scene_.dem.settle_time;
   const FillResult r = rcfd::fillAndSettle(*dem_, defaultFillRegion(scene_.apparatus), parcelsForBedMass(scene_), options);
   demStep_ = dem_->steps();
+  lastInterval_ = 0.0;  // the gas starts from here: no rate of change of alpha_G yet
   return r;
 }
 
@@ -76,7 +77,7 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
   std::int64_t k = std::min<std::int64_t>(scene_.dem.coupling_interval, left);
   last_ = CfdDemStepStats{};
   if (gas_) {
-    coupling_->fluid->prepare();
+    coupling_->fluid->prepare(lastInterval_);
     // The gas step is a whole number of DEM steps, as long as the CFL (and source) limit allows;
     // a limit below dt_DEM splits that one DEM step into several equal gas steps.
     const double stable = gas_->stableTimeStep();
@@ -103,6 +104,7 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
   demStep_ += k;
   last_.demSteps = int(k);
   last_.dt = double(k) * dtDem;
+  lastInterval_ = last_.dt;
   const DemParticles& p = dem_->particles();
   for (std::size_t i = 0; i < p.size(); ++i)
     if (!p.x[i].allFinite() || !p.v[i].allFinite()) {
@@ -121,7 +123,8 @@ double CfdDemSimulation::demTimeStep() const { return dem_->timeStep(); }
 const coupling::FluidCoupling* CfdDemSimulation::fluidCoupling() const { return coupling_->fluid.get(); }
 
 std::vector<double> CfdDemSimulation::particleFraction() const {
-  if (coupling_->fluid) return coupling_->fluid->particleFraction();
+  if (coupling_->fluid)
+    return coupling_->fluid->prepared() ? coupling_->fluid->particleFraction() : coupling_->fluid->currentFraction();
   const auto& map = coupling_->map();
   std::vector<coupling::KernelWeights> w;
   std::vector<double> volume;
@@ -143,13 +146,21 @@ std::vector<Eigen::Vector3d> CfdDemSimulation::gasVelocity() const {
   return std::vector<Eigen::Vector3d>(std::size_t(grid_.cellCount()), Eigen::Vector3d::Zero());
 }
 
-double CfdDemSimulation::pressureDrop() const { return gas_ ? gas_->pressureDrop() : 0.0; }
+double CfdDemSimulation::pressureDrop() const {
+  if (!gas_) return 0.0;
+  // The gas has gravity (buoyancy on the parcels): its own hydrostatic head between the inlet cells'
+  // centres and the outlet, rho_G g (H - h/2), is not part of the bed's pressure drop.
+  const double head = scene_.gas.density * dem_->settings().gravity.norm() *
+                      (grid_.upperCorner().y() - grid_.origin.y() - 0.5 * grid_.spacing.y());
+  return gas_->pressureDrop() - head;
+}
 
 void CfdDemSimulation::saveState(h5::File& file, const std::string& group) const {
   file.createGroup(group);
   dem_->saveState(file, group + "/dem");
   file.setAttribute(group, "dem_step", std::int64_t(demStep_));
   file.setAttribute(group, "has_gas", std::int64_t(gas_ ? 1 : 0));
+  file.setAttribute(group, "last_interval", lastInterval_);
   if (gas_) {
     gas_->saveState(file, group + "/gas");
     file.write(group + "/alpha_p", coupling_->fluid->particleFraction());
@@ -162,6 +173,7 @@ void CfdDemSimulation::loadState(const h5::File& file, const std::string& group)
                    (gas_ ? " has no gas state, but the scene lists gas" : " has a gas state, but the scene has no gas"));
   dem_->loadState(file, group + "/dem");
   demStep_ = file.intAttribute(group, "dem_step");
+  lastInterval_ = file.doubleAttribute(group, "last_interval");
   if (gas_) {
     gas_->loadState(file, group + "/gas");
     coupling_->fluid->restoreFraction(file.readDoubles(group + "/alpha_p"));

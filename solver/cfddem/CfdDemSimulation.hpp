@@ -78,14 +78,16 @@ class CfdDemSimulation {
   bool hasGas() const { return gas_ != nullptr; }
   const gas::GasSolver* gasSolver() const { return gas_.get(); }
 
-  /// alpha_P per cell as the coupling sees it (after smoothing when enabled) [-]; computed from the
-  /// current particles on demand when the gas is off.
+  /// alpha_P per cell as the coupling sees it (after smoothing when enabled) [-]: the field of the last
+  /// coupling step (its start), computed from the current particles before the first one and when the
+  /// gas is off.
   std::vector<double> particleFraction() const;
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> particleVelocity() const;
   /// Gas velocity at cell centres, zero in closed cells and without gas [m/s].
   std::vector<Eigen::Vector3d> gasVelocity() const;
-  /// Bed pressure drop: inlet minus outlet pressure [Pa]; 0 without gas.
+  /// Bed pressure drop: inlet minus outlet pressure [Pa], less the gas's own hydrostatic head
+  /// rho_G g (H - h/2) (the gas has gravity); 0 without gas.
   double pressureDrop() const;
 
   /// Whole state (particles, contact history where kept, gas, clock) into / from a checkpoint group.
@@ -108,6 +110,7 @@ class CfdDemSimulation {
   std::unique_ptr<Coupling> coupling_;
   CfdDemStepStats last_;
   std::int64_t demStep_ = 0;
+  double lastInterval_ = 0.0;  ///< duration of the last coupling step [s] (dalpha_G/dt of the next)
 };
 
 }  // namespace rcfd

@@ -40,14 +40,15 @@ void printBed(const CfdDemSimulation& sim) {
 // 0.2 m/s in 0.05 s and ramps on to 0.9 m/s in 0.5 s (below U_mf the bed does not move, so the ramp may
 // be fast). The pressure drop is extrapolated from the two lowest cell rows to the inlet face.
 TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
-  const double uMax = 0.9, uStart = 0.2, width = 0.05, startTime = 0.05, rampTime = 0.5;
+  const double uMax = 0.9, uStart = 0.2, startTime = 0.05, rampTime = 0.5;
+  const double width = std::getenv("RCFD_FLUID_WIDTH") ? std::atof(std::getenv("RCFD_FLUID_WIDTH")) : 0.05;
   Scene s = test::couplingBox(Vec3(width, 0.08, width), 0.005, uMax * width * width);
   s.dem.coarse_graining = 2.0;
   s.dem.time_step = 4e-5;  // 0.28 of the Rayleigh time of the 3.6 mm parcels
   s.dem.coupling_interval = 10;
   s.gas.max_time_step = 4e-4;
   s.dem.settle_time = 0.15;
-  s.process.bed_mass = 0.04;  // 1570 parcels, a bed about 2.6 cm high
+  s.process.bed_mass = 0.04 * width * width / 0.0025;  // 1570 parcels in 5 cm: a bed about 2.6 cm high
   s.effects = {"gas", "drag", "rolling_friction"};
   if (std::getenv("RCFD_SMOOTHING")) s.effects.push_back("smoothing");
   gas::GasOptions go;
@@ -59,7 +60,7 @@ TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
   double weight = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) weight += p.mass[i] * 9.81 * (1 - s.gas.density / s.particles.density);
   const double target = weight / (width * width);  // [Pa]
-  const double hydrostatic = s.gas.density * 9.81 * s.apparatus.size.y();
+  const double hydrostatic = s.gas.density * 9.81 * s.apparatus.size.y();  // from y = 0 to the top
   const bool debug = std::getenv("RCFD_DEBUG") != nullptr;
   const auto& g = sim.grid();
   auto inletPressure = [&] {  // area mean of the two lowest rows, extrapolated to y = 0

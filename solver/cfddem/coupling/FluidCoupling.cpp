@@ -38,7 +38,21 @@ std::vector<Eigen::Vector3d> FluidCoupling::gasVelocitySeen() const {
   return u;
 }
 
-void FluidCoupling::prepare() {
+std::vector<double> FluidCoupling::currentFraction() const {
+  std::vector<KernelWeights> w;
+  std::vector<double> volume;
+  mapping_->weightsOf(dem_.particles(), w);
+  mapping_->scatterVolume(dem_.particles(), w, volume);
+  if (smoother_) {
+    std::vector<double> a = mapping_->fractionOf(volume);
+    smoother_->smooth(a);
+    for (std::size_t c = 0; c < a.size(); ++c) volume[c] = a[c] * mapping_->openVolume(c);
+  }
+  mapping_->redistributeExcess(volume, options_.maxParticleFraction);
+  return mapping_->fractionOf(volume);
+}
+
+void FluidCoupling::prepare(double interval) {
   const DemParticles& p = dem_.particles();
   const std::size_t n = p.size(), cells = alphaP_.size();
   mapping_->weightsOf(p, weights_);
@@ -70,8 +84,13 @@ void FluidCoupling::prepare() {
       throw RunError(s.str());
     }
   }
-  if (first_) gas_.setGasFraction(alphaG_, std::vector<double>(cells, 0.0));
-  else gas_.setGasFraction(alphaG_);
+  // dalpha_G/dt as a backward difference over the interval in which the parcels moved (the previous
+  // coupling step), not over the coming gas step: the two differ whenever a step is cut short (to hit
+  // a sampling instant) and the gas would see the change at the wrong rate (pressure spikes).
+  std::vector<double> rate(cells, 0.0);
+  if (!first_ && interval > 0)
+    for (std::size_t c = 0; c < cells; ++c) rate[c] = (alphaG_[c] - gas_.gasFractionOf(c)) / interval;
+  gas_.setGasFraction(alphaG_, rate);
   first_ = false;
 
   k_.assign(n, 0.0);

@@ -36,12 +36,18 @@ class FluidCoupling {
  public:
   FluidCoupling(const Scene& scene, gas::GasSolver& gas, DemSystem& dem, FluidCouplingOptions options);
 
-  /// Step 1: maps the particles, hands alpha_G (with dalpha/dt over dtNext) and the drag to the gas.
-  /// Throws RunError when a cell stays over-packed (alpha_G <= 0 would follow) or a value is not finite.
-  void prepare();
+  /// Step 1: maps the particles, hands alpha_G and the drag to the gas. dalpha_G/dt is the change since
+  /// the last prepare() over `interval`, the time the parcels moved since then [s] (0: no rate, e.g. at
+  /// the start). Throws RunError when a cell stays over-packed or a value is not finite.
+  void prepare(double interval = 0.0);
   /// Step 2: fluid forces on the parcels from the gas state after its step.
   void applyForces();
 
+  /// True once prepare() ran (or a checkpoint was restored): particleFraction() is the coupling's.
+  bool prepared() const { return !first_; }
+  /// alpha_P of the current parcels, processed as prepare() does (smoothing, redistribution), without
+  /// touching the gas [-].
+  std::vector<double> currentFraction() const;
   /// alpha_P per cell after smoothing and redistribution [-].
   const std::vector<double>& particleFraction() const { return alphaP_; }
   const std::vector<double>& gasFraction() const { return alphaG_; }

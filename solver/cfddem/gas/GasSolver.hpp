@@ -141,6 +141,7 @@ class GasSolver {
   void buildTopology();
   void buildNozzle();
   double chooseDt(double maxDt) const;
+  double convectiveRate() const;
   void explicitRates(const std::array<std::vector<double>, 3>& u, std::array<std::vector<double>, 3>& rate) const;
   double ghostValue(const std::vector<double>& u, int d, int e, std::array<int, 3> idx) const;
   double faceAlpha(int d, std::size_t f, int i, int j, int k) const;
