@@ -173,7 +173,11 @@ void CfdDemSimulation::loadState(const h5::File& file, const std::string& group)
                    (gas_ ? " has no gas state, but the scene lists gas" : " has a gas state, but the scene has no gas"));
   dem_->loadState(file, group + "/dem");
   demStep_ = file.intAttribute(group, "dem_step");
-  lastInterval_ = file.doubleAttribute(group, "last_interval");
+  try {
+    lastInterval_ = file.doubleAttribute(group, "last_interval");
+  } catch (const RunError&) {
+    lastInterval_ = 0.0;  // a checkpoint of an earlier version: the next step takes no dalpha/dt
+  }
   if (gas_) {
     gas_->loadState(file, group + "/gas");
     coupling_->fluid->restoreFraction(file.readDoubles(group + "/alpha_p"));
