@@ -9,6 +9,7 @@
 //   into a checkpoint; RCFD_BENCH_CFDDEM_START=path: start from such a checkpoint (no fill, no ramp);
 //   RCFD_BENCH_CFDDEM_PGM=prefix: also writes alpha_P (mean over z) as prefix-N.pgm every 0.2 s and
 //   prefix-alpha.pgm at the end. A progress line every 0.05 s simulated goes to stderr.
+//   RCFD_BENCH_CFDDEM_SERIES=path: time, pressure drop and DEM steps of every coupling step.
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -97,6 +98,8 @@ nlohmann::json runCfdDem(const Options& o) {
   const std::int64_t report = std::max<std::int64_t>(1, std::llround(0.05 * stepsPerSecond));
   std::int64_t nextReport = start + report;
   const char* pgm = std::getenv("RCFD_BENCH_CFDDEM_PGM");
+  std::ofstream series;  // RCFD_BENCH_CFDDEM_SERIES=path: time, pressure drop, DEM steps per coupling step
+  if (const char* path = std::getenv("RCFD_BENCH_CFDDEM_SERIES")) series.open(path);
   while (sim.demStep() < end) {
     sim.step(std::min(end, nextReport));
     if (sim.demStep() == nextReport) {
@@ -108,6 +111,7 @@ nlohmann::json runCfdDem(const Options& o) {
       nextReport += report;
     }
     ++couplingSteps;
+    if (series.is_open()) series << sim.time() << " " << sim.pressureDrop() << " " << sim.lastStep().demSteps << "\n";
     pressureIterations += sim.lastStep().pressureIterations;
     maxAlphaP = std::max(maxAlphaP, sim.lastStep().maxAlphaP);
     maxCourant = std::max(maxCourant, sim.lastStep().courant);
