@@ -123,8 +123,9 @@ double CfdDemSimulation::demTimeStep() const { return dem_->timeStep(); }
 const coupling::FluidCoupling* CfdDemSimulation::fluidCoupling() const { return coupling_->fluid.get(); }
 
 std::vector<double> CfdDemSimulation::particleFraction() const {
-  if (coupling_->fluid)
-    return coupling_->fluid->prepared() ? coupling_->fluid->particleFraction() : coupling_->fluid->currentFraction();
+  // From the current parcels (the coupling's own field is that of the start of the last coupling
+  // step), so a sampled frame's alpha_P, u_P and u_G belong to the same instant.
+  if (coupling_->fluid) return coupling_->fluid->currentFraction();
   const auto& map = coupling_->map();
   std::vector<coupling::KernelWeights> w;
   std::vector<double> volume;

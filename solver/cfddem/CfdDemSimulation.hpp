@@ -78,9 +78,8 @@ class CfdDemSimulation {
   bool hasGas() const { return gas_ != nullptr; }
   const gas::GasSolver* gasSolver() const { return gas_.get(); }
 
-  /// alpha_P per cell as the coupling sees it (after smoothing when enabled) [-]: the field of the last
-  /// coupling step (its start), computed from the current particles before the first one and when the
-  /// gas is off.
+  /// alpha_P per cell of the current parcels, processed as the coupling does (smoothing when enabled,
+  /// over-packing redistribution) [-]: the same instant as particleVelocity() and gasVelocity().
   std::vector<double> particleFraction() const;
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> particleVelocity() const;
