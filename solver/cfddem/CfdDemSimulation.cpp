@@ -76,6 +76,7 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
   const std::int64_t left = untilDemStep - demStep_;
   std::int64_t k = std::min<std::int64_t>(scene_.dem.coupling_interval, left);
   last_ = CfdDemStepStats{};
+  checkParcels();  // a parcel changed from outside (or a bad checkpoint) is named before the gas sees it
   if (gas_) {
     coupling_->fluid->prepare(lastInterval_);
     // The gas step is a whole number of DEM steps, as long as the CFL (and source) limit allows;
@@ -105,15 +106,19 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
   last_.demSteps = int(k);
   last_.dt = double(k) * dtDem;
   lastInterval_ = last_.dt;
+  checkParcels();
+  return last_;
+}
+
+void CfdDemSimulation::checkParcels() const {
   const DemParticles& p = dem_->particles();
   for (std::size_t i = 0; i < p.size(); ++i)
     if (!p.x[i].allFinite() || !p.v[i].allFinite()) {
       std::ostringstream m;
       m << "CFD-DEM: parcel " << p.id[i] << " has a non-finite position or velocity at t = " << time()
-        << " s (DEM step " << demStep_ << "), last at x = (" << p.x[i].transpose() << ")";
+        << " s (DEM step " << demStep_ << "), at x = (" << p.x[i].transpose() << ")";
       throw RunError(m.str());
     }
-  return last_;
 }
 
 std::int64_t CfdDemSimulation::demStep() const { return demStep_; }

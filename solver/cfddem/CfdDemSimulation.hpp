@@ -99,6 +99,8 @@ class CfdDemSimulation {
 
  private:
   struct Coupling;  // volume mapping, drag, exchange (cfddem/coupling/)
+  /// RunError naming the first parcel with a non-finite position or velocity.
+  void checkParcels() const;
 
   const Scene& scene_;
   std::uint64_t seed_;
