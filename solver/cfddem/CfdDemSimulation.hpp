@@ -28,6 +28,10 @@ class File;
 }
 namespace gas {
 class GasSolver;
+struct GasOptions;
+}
+namespace coupling {
+class FluidCoupling;
 }
 
 /// Figures of the last coupling step.
@@ -45,6 +49,9 @@ class CfdDemSimulation {
   /// lists `gas`, the gas solver and coupling (`drag`, `smoothing` select their stages). Throws
   /// InputError naming the scene field on an inconsistent set-up.
   CfdDemSimulation(const Scene& scene, std::uint64_t seed);
+  /// The same with gas-solver options that are not in the scene (verification set-ups: a box with a
+  /// bottom inlet, slip walls). The gas gravity is always the DEM's.
+  CfdDemSimulation(const Scene& scene, std::uint64_t seed, const gas::GasOptions& gasOptions);
   ~CfdDemSimulation();
 
   /// Inserts the scene's bed mass as parcels and lets it settle (DEM only, gas off), at most
@@ -71,14 +78,15 @@ class CfdDemSimulation {
   bool hasGas() const { return gas_ != nullptr; }
   const gas::GasSolver* gasSolver() const { return gas_.get(); }
 
-  /// alpha_P per cell as the coupling sees it (after smoothing when enabled) [-]; computed from the
-  /// current particles on demand when the gas is off.
+  /// alpha_P per cell of the current parcels, processed as the coupling does (smoothing when enabled,
+  /// over-packing redistribution) [-]: the same instant as particleVelocity() and gasVelocity().
   std::vector<double> particleFraction() const;
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> particleVelocity() const;
   /// Gas velocity at cell centres, zero in closed cells and without gas [m/s].
   std::vector<Eigen::Vector3d> gasVelocity() const;
-  /// Bed pressure drop: inlet minus outlet pressure [Pa]; 0 without gas.
+  /// Bed pressure drop: inlet minus outlet pressure [Pa], less the gas's own hydrostatic head
+  /// rho_G g (H - h/2) (the gas has gravity); 0 without gas.
   double pressureDrop() const;
 
   /// Whole state (particles, contact history where kept, gas, clock) into / from a checkpoint group.
@@ -86,9 +94,13 @@ class CfdDemSimulation {
   void loadState(const h5::File& file, const std::string& group);
 
   const CfdDemStepStats& lastStep() const { return last_; }
+  /// The coupling (mapping, drag, exchange sums); null without `gas`.
+  const coupling::FluidCoupling* fluidCoupling() const;
 
  private:
   struct Coupling;  // volume mapping, drag, exchange (cfddem/coupling/)
+  /// RunError naming the first parcel with a non-finite position or velocity.
+  void checkParcels() const;
 
   const Scene& scene_;
   std::uint64_t seed_;
@@ -99,6 +111,7 @@ class CfdDemSimulation {
   std::unique_ptr<Coupling> coupling_;
   CfdDemStepStats last_;
   std::int64_t demStep_ = 0;
+  double lastInterval_ = 0.0;  ///< duration of the last coupling step [s] (dalpha_G/dt of the next)
 };
 
 }  // namespace rcfd

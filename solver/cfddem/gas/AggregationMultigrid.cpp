@@ -73,9 +73,20 @@ void AggregationMultigrid::cycle(int l, const Eigen::VectorXd& b, Eigen::VectorX
   const Level& L = levels_[std::size_t(l)];
   x.setZero(b.size());
   gaussSeidel(L.a, b, x, true);
-  const Eigen::VectorXd r = b - L.a * x;
+  // Residual restricted to the aggregates in one row loop (Eigen's b - A x expression was 4% of a
+  // coupled CFD-DEM step).
   Eigen::VectorXd rc = Eigen::VectorXd::Zero(L.coarseCount), xc;
-  for (int i = 0; i < int(r.size()); ++i) rc[L.coarseOf[std::size_t(i)]] += r[i];
+  {
+    const int n = int(L.a.rows());
+    const int* outer = L.a.outerIndexPtr();
+    const int* inner = L.a.innerIndexPtr();
+    const double* val = L.a.valuePtr();
+    for (int i = 0; i < n; ++i) {
+      double s = 0.0;
+      for (int q = outer[i]; q < outer[i + 1]; ++q) s += val[q] * x[inner[q]];
+      rc[L.coarseOf[std::size_t(i)]] += b[i] - s;
+    }
+  }
   cycle(l + 1, rc, xc);
   for (int i = 0; i < int(x.size()); ++i) x[i] += xc[L.coarseOf[std::size_t(i)]];
   gaussSeidel(L.a, b, x, false);

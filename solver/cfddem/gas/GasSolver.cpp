@@ -57,6 +57,9 @@ GasSolver::GasSolver(const Scene& scene, const Apparatus& apparatus, const Carte
   ap_ = computeFaceApertures(apparatus_, grid_);
   buildTopology();
   buildNozzle();
+  source0_ = source_;
+  inletVelocity0_ = inletVelocity_;
+  nozzleJetVelocity0_ = nozzleJetVelocity_;
 }
 
 GasSolver::~GasSolver() = default;
@@ -253,14 +256,8 @@ double GasSolver::faceAlpha(int d, std::size_t f, int i, int j, int k) const {
 }
 
 double GasSolver::chooseDt(double maxDt) const {
+  const double rate = convectiveRate();  // max over cells of sum_d |u_d| / h_d
   const Eigen::Vector3d h = grid_.spacing;
-  double rate = 0.0;  // sum over axes of max |u_d| / h_d
-  for (int d = 0; d < 3; ++d) {
-    double m = 0.0;
-    for (double v : u_[std::size_t(d)]) m = std::max(m, std::abs(v));
-    if (d == 1) m = std::max(m, nozzleJetVelocity_);
-    rate += m / h[d];
-  }
   double dt = std::min(maxDt, scene_.gas.max_time_step);
   if (rate > 0) dt = std::min(dt, scene_.gas.cfl / rate);
   const double nu = scene_.gas.kinematic_viscosity;
@@ -271,6 +268,28 @@ double GasSolver::chooseDt(double maxDt) const {
     if (source_[c] > 0) sMax = std::max(sMax, source_[c] / alphaNext_[c]);
   if (sMax > 0) dt = std::min(dt, kSourceSafety / sMax);
   return dt;
+}
+
+double GasSolver::convectiveRate() const {
+  // Per cell: the larger |u| of its two faces per axis over h, summed over the axes (the nozzle's jet
+  // velocity counts in the cells it enters). The CFL number is a property of a cell: the maximum of
+  // this sum, not the sum of each axis' maximum over the whole domain (which pairs the jet's u_y with
+  // some other cell's u_x).
+  const Eigen::Vector3d h = grid_.spacing;
+  const auto n = grid_.shape;
+  double rate = 0.0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        const std::size_t c = std::size_t(grid_.flatIndex(i, j, k));
+        if (!active_[c]) continue;
+        const double ux = std::max(std::abs(u_[0][faceIndex(0, i, j, k)]), std::abs(u_[0][faceIndex(0, i + 1, j, k)]));
+        double uy = std::max(std::abs(u_[1][faceIndex(1, i, j, k)]), std::abs(u_[1][faceIndex(1, i, j + 1, k)]));
+        if (source_[c] > 0) uy = std::max(uy, nozzleJetVelocity_);
+        const double uz = std::max(std::abs(u_[2][faceIndex(2, i, j, k)]), std::abs(u_[2][faceIndex(2, i, j, k + 1)]));
+        rate = std::max(rate, ux / h.x() + uy / h.y() + uz / h.z());
+      }
+  return rate;
 }
 
 double GasSolver::ghostValue(const std::vector<double>& u, int d, int e, std::array<int, 3> idx) const {
@@ -444,13 +463,7 @@ double GasSolver::step(double maxDt) {
   time_ += dt;
   lastDt_ = dt;
   last_.dt = dt;
-  double rateMax = 0.0;
-  for (int d = 0; d < 3; ++d) {
-    double m = 0.0;
-    for (double v : u_[std::size_t(d)]) m = std::max(m, std::abs(v));
-    rateMax += m / grid_.spacing[d];
-  }
-  last_.courant = dt * rateMax;
+  last_.courant = dt * convectiveRate();
   for (int d = 0; d < 3; ++d)
     for (double v : u_[std::size_t(d)])
       if (!std::isfinite(v))

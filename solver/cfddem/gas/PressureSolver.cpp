@@ -3,6 +3,7 @@
 #include "cfddem/gas/PressureSolver.hpp"
 
 #include <Eigen/IterativeLinearSolvers>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -80,11 +81,23 @@ void multiply(const PressureSolver::Matrix& a, const Eigen::VectorXd& x, Eigen::
   }
 }
 
+/// Dot product summed in fixed blocks whose partial sums are added in block order: the same bits for
+/// any number of threads (an OpenMP reduction sums in a thread-dependent order, which would make the
+/// coupled CFD-DEM depend on the thread count).
+constexpr long kDotBlock = 2048;
 double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const long n = a.size();
+  const long blocks = (n + kDotBlock - 1) / kDotBlock;
+  std::vector<double> partial(std::size_t(std::max(blocks, 1L)), 0.0);
+#pragma omp parallel for schedule(static) if (n > kParallelRows)
+  for (long k = 0; k < blocks; ++k) {
+    double s = 0.0;
+    const long end = std::min(n, (k + 1) * kDotBlock);
+    for (long i = k * kDotBlock; i < end; ++i) s += a[i] * b[i];
+    partial[std::size_t(k)] = s;
+  }
   double s = 0.0;
-#pragma omp parallel for reduction(+ : s) schedule(static) if (n > kParallelRows)
-  for (long i = 0; i < n; ++i) s += a[i] * b[i];
+  for (double p : partial) s += p;
   return s;
 }
 
