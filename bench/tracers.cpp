@@ -2,7 +2,9 @@
 // grid of about 73,647 cells, synthetic pseudo-periodic fields (a swaying spout), effects transport +
 // fluctuation + walls + tracer_volume_fraction. Also the cost of each effect added on its own.
 #include <chrono>
+#include <ctime>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <numbers>
 
@@ -33,19 +35,32 @@ void swayingSpout(const CartesianGrid& grid, int, double t, FieldFrame& f) {
 struct Timing {
   double secondsPerStep = 0.0;
   double tracerStepsPerSecond = 0.0;
+  double cpuSecondsPerStep = 0.0;  ///< process CPU time (all threads) per step: what the load distorts least
+  double substepFraction = 0.0;    ///< extra sub-steps per tracer-step (last step)
+  double wallHitFraction = 0.0;    ///< reflections per tracer-step (last step)
 };
+
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int steps) {
   RecurrencePath path;
   for (int k = 0; k < steps + 2; ++k) path.frames.push_back(k % db->frameCount());
   TracerSimulation sim(scene, db, path, {1, steps, 0});
   sim.step();  // warm caches and first-touch pages outside the timing
+  const double cpu0 = processCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 1; k < steps; ++k) sim.step();
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Timing t;
   t.secondsPerStep = s / (steps - 1);
+  t.cpuSecondsPerStep = (processCpuSeconds() - cpu0) / (steps - 1);
   t.tracerStepsPerSecond = double(scene.rcfd.tracers) / t.secondsPerStep;
+  t.substepFraction = double(sim.motionStatistics().substeps) / double(scene.rcfd.tracers);
+  t.wallHitFraction = double(sim.motionStatistics().wallHits) / double(scene.rcfd.tracers);
   return t;
 }
 
@@ -69,7 +84,11 @@ nlohmann::json runTracers(const Options& options) {
   scene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
   const Timing headline = timeRun(scene, db, steps);
   std::cerr << "transport+fluctuation+walls+tracer_volume_fraction: " << headline.tracerStepsPerSecond
-            << " tracer-steps/s (" << headline.secondsPerStep * 1e3 << " ms/step)\n";
+            << " tracer-steps/s (" << headline.secondsPerStep * 1e3 << " ms/step, "
+            << headline.cpuSecondsPerStep * 1e3 << " CPU-ms/step, "
+            << headline.cpuSecondsPerStep / double(scene.rcfd.tracers) * 1e9 << " CPU-ns/tracer-step; "
+            << headline.substepFraction << " extra sub-steps and " << headline.wallHitFraction
+            << " reflections per tracer-step)\n";
 
   nlohmann::json costs = nlohmann::json::object();
   const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
@@ -79,14 +98,23 @@ nlohmann::json runTracers(const Options& options) {
       {"+residence_time", {"transport", "walls", "fluctuation", "tracer_volume_fraction", "residence_time"}},
       {"+field_average", {"transport", "walls", "fluctuation", "tracer_volume_fraction", "field_average"}},
   };
+  // RCFD_BENCH_TRACERS_HEADLINE_ONLY=1: the headline configuration only (A/B comparisons of the kernel).
+  const char* headlineOnly = std::getenv("RCFD_BENCH_TRACERS_HEADLINE_ONLY");
   for (const auto& [label, effects] : variants) {
+    if (headlineOnly && std::string(headlineOnly) == "1") break;
     scene.effects = effects;
     const Timing t = timeRun(scene, db, steps);
-    costs[label] = {{"ms_per_step", t.secondsPerStep * 1e3}, {"tracer_steps_per_s", t.tracerStepsPerSecond}};
-    std::cerr << label << ": " << t.secondsPerStep * 1e3 << " ms/step\n";
+    costs[label] = {{"ms_per_step", t.secondsPerStep * 1e3},
+                    {"cpu_ms_per_step", t.cpuSecondsPerStep * 1e3},
+                    {"tracer_steps_per_s", t.tracerStepsPerSecond}};
+    std::cerr << label << ": " << t.secondsPerStep * 1e3 << " ms/step, " << t.cpuSecondsPerStep * 1e3
+              << " CPU-ms/step\n";
   }
   return {{"tracer_steps_per_s", headline.tracerStepsPerSecond},
           {"ms_per_step", headline.secondsPerStep * 1e3},
+          {"cpu_ms_per_step", headline.cpuSecondsPerStep * 1e3},
+          {"cpu_ns_per_tracer_step", headline.cpuSecondsPerStep / double(scene.rcfd.tracers) * 1e9},
+          {"tracer_steps_per_cpu_s", double(scene.rcfd.tracers) / headline.cpuSecondsPerStep},
           {"tracers", scene.rcfd.tracers},
           {"cells", grid.cellCount()},
           {"effect_costs", costs}};
