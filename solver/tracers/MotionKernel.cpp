@@ -26,13 +26,20 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
   if (settings_.walls) {
     // A point of cell c lies at most half a diagonal from its centre, so its wall distance is at least
     // sd(centre) - halfDiagonal: a move shorter than that cannot reach a wall (the fast path).
+    // The block path uses the sharper per-point bound sd(p) >= sd(centre) - |p - centre| (signed
+    // distances are 1-Lipschitz) against `reach`: sd(centre) less twice the band in which
+    // firstIntersection() reports hits, so a move it accepts is one the exact test would not stop.
     const double halfDiagonal = 0.5 * grid_.spacing.norm();
+    const double band = 2.0 * apparatus_.boundaryTolerance();
     clearance_.resize(std::size_t(grid_.cellCount()));
+    reach_.resize(std::size_t(grid_.cellCount()));
 #pragma omp parallel for schedule(static) if (grid_.cellCount() > kParallelThreshold)
     for (std::int64_t c = 0; c < grid_.cellCount(); ++c) {
       const auto ijk = grid_.cellIjk(c);
       const double sd = apparatus_.signedDistance(grid_.cellCenter(ijk[0], ijk[1], ijk[2]));
+      // The factor 1 - 1e-6 covers the rounding to float (6e-8) and of the distances.
       clearance_[std::size_t(c)] = float(std::max(0.0, sd - halfDiagonal) * (1.0 - 1e-6));
+      reach_[std::size_t(c)] = float(std::max(0.0, sd - band) * (1.0 - 1e-6));
     }
   }
 }
@@ -88,7 +95,7 @@ void MotionKernel::prepare(const TracerContext& ctx, const FrameSampler& sampler
       speed = std::min(model->speed(ctx.tracerAlpha[std::size_t(c)], sampler.alphaP(c), settings_.d0, dt),
                        settings_.uFlucMax);
     }
-    cellData_[2 * std::size_t(c)] = settings_.walls ? clearance_[std::size_t(c)] : 0.0f;
+    cellData_[2 * std::size_t(c)] = settings_.walls ? reach_[std::size_t(c)] : 0.0f;
     cellData_[2 * std::size_t(c) + 1] = float(speed);
   }
 }
@@ -171,7 +178,7 @@ void MotionKernel::move(TracerContext& ctx) {
   prepare(ctx, sampler, fluctuate);
   const CounterRngPrefix rngPrefix(ctx.seed, RngPurpose::Fluctuation, std::uint64_t(ctx.step));
   const std::int64_t n = std::int64_t(cloud.size());
-  std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0;
+  std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0, scalarPath = 0;
   // Sub-steps so that no sub-step moves farther than max_courant cells; a non-finite or enormous
   // displacement gets kMaxSubsteps (the exact wall tests still keep the tracer inside).
   const double cellLimit = settings_.maxCourant * minSpacing_;
@@ -185,6 +192,17 @@ void MotionKernel::move(TracerContext& ctx) {
   };
   const float* field = particleVelocity_.floats();
   const float* cellData = cellData_.data();
+  const double noWall = settings_.walls ? 0.0 : 1e300;  // without walls every move is within reach
+  struct {
+    double origin[3], inv[3], spacing[3];
+    int last[3];
+    std::int32_t sy, sz;
+  } g{};
+  for (int d = 0; d < 3; ++d) {
+    g.origin[d] = grid_.origin[d], g.inv[d] = 1.0 / grid_.spacing[d], g.spacing[d] = grid_.spacing[d];
+    g.last[d] = grid_.shape[d] - 1;
+  }
+  g.sy = grid_.shape[0], g.sz = grid_.shape[0] * grid_.shape[1];
   const bool midpoint = settings_.midpoint;
   const bool walls = settings_.walls;
 
@@ -194,7 +212,7 @@ void MotionKernel::move(TracerContext& ctx) {
     Eigen::Vector3d p = cloud.position(std::size_t(i));
     Eigen::Vector3d v = cloud.velocity(std::size_t(i));
     // The first move of a tracer starts in `cell`: its clearance is known (walls on) or unused.
-    const double firstClearance = walls ? double(cellData_[2 * std::size_t(cell)]) : -1.0;
+    const double firstClearance = walls ? double(clearance_[std::size_t(cell)]) : -1.0;
     if (settings_.freeFlight && sampler.alphaP(cell) < settings_.freeFlightAlpha) {
       // Free flight: implicit drag relaxation toward u_G^rec plus gravity, stable for any dt / tau.
       ++st.freeFlight;
@@ -232,7 +250,7 @@ void MotionKernel::move(TracerContext& ctx) {
   double* const px = cloud.x.data();
   double* const py = cloud.y.data();
   double* const pz = cloud.z.data();
-#pragma omp parallel for schedule(static) reduction(+ : substeps, wallHits, freeFlight, capped) if (n > kParallelThreshold)
+#pragma omp parallel for schedule(static) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath) if (n > kParallelThreshold)
   for (std::int64_t b = 0; b < blocks; ++b) {
     const std::int64_t i0 = b * kBlock;
     const int count = int(std::min<std::int64_t>(kBlock, n - i0));
@@ -240,7 +258,7 @@ void MotionKernel::move(TracerContext& ctx) {
     alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
     alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];  // u at the start (then at the midpoint)
     alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];  // midpoint
-    alignas(64) double clearance[kBlock], speed[kBlock];
+    alignas(64) double speed[kBlock];
     std::int32_t cellOf[kBlock];
     std::int64_t scalar[kBlock], fast[kBlock];  // flags; not bool, which stops the vectoriser
     // Cells, then their clearance and Eq. (10) speed: independent loads the vectorised loop issues as
@@ -255,10 +273,8 @@ void MotionKernel::move(TracerContext& ctx) {
     } else {
       for (int k = 0; k < count; ++k) scalar[k] = 0;
     }
-    const double noWall = walls ? 0.0 : 1e300;  // clearance without walls: nothing is within reach
 #pragma omp simd
     for (int k = 0; k < count; ++k) {
-      clearance[k] = double(cellData[2 * cellOf[k]]) + noWall;
       speed[k] = double(cellData[2 * cellOf[k] + 1]) * double(1 - scalar[k]);  // none in free flight
     }
     // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
@@ -292,11 +308,23 @@ void MotionKernel::move(TracerContext& ctx) {
       fast[k] = (!scalar[k]) & (d2 <= limit2);
     }
     if (midpoint) sampleBlock(locator, field, count, mx, my, mz, ax, ay, az, ux, uy, uz);
+    // Walls: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move inside.
 #pragma omp simd
     for (int k = 0; k < count; ++k) {
       const double dx = dt * ux[k], dy = dt * uy[k], dz = dt * uz[k];
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      fast[k] = fast[k] & (d2 < clearance[k] * clearance[k]);
+      const double length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      int ci[3];
+      double off2 = 0.0;
+      const double pk[3] = {x[k], y[k], z[k]};
+      for (int d = 0; d < 3; ++d) {
+        const double t = (pk[d] - g.origin[d]) * g.inv[d];
+        const int i = int(t > 0.0 ? t : 0.0);
+        ci[d] = i < g.last[d] ? i : g.last[d];
+        const double e = pk[d] - (g.origin[d] + (double(ci[d]) + 0.5) * g.spacing[d]);
+        off2 += e * e;
+      }
+      const double reach = double(cellData[2 * (ci[0] + ci[1] * g.sy + ci[2] * g.sz)]) + noWall;
+      fast[k] = fast[k] & (std::sqrt(off2) + length < reach);
     }
     for (int k = 0; k < count; ++k) {
       const std::int64_t i = i0 + k;
@@ -305,14 +333,17 @@ void MotionKernel::move(TracerContext& ctx) {
         cloud.vx[std::size_t(i)] = ux[k], cloud.vy[std::size_t(i)] = uy[k], cloud.vz[std::size_t(i)] = uz[k];
       } else {
         moveOne(i, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+        ++st.scalarPath;
       }
     }
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
+    scalarPath += st.scalarPath;
   }
   stats_.substeps = substeps;
   stats_.wallHits = wallHits;
   stats_.freeFlight = freeFlight;
   stats_.substepCapped = capped;
+  stats_.scalarPath = scalarPath;
 }
 
 }  // namespace rcfd

@@ -20,6 +20,7 @@ struct MotionStatistics {
   std::int64_t wallHits = 0;        ///< reflections
   std::int64_t freeFlight = 0;      ///< tracers in free flight
   std::int64_t substepCapped = 0;   ///< tracers that needed more than kMaxSubsteps
+  std::int64_t scalarPath = 0;      ///< tracers moved one by one (sub-steps, a wall within reach, free flight)
 };
 
 class MotionKernel {
@@ -47,6 +48,7 @@ class MotionKernel {
   const Apparatus& apparatus_;
   const CartesianGrid& grid_;
   std::vector<float> clearance_;  ///< lower bound of the wall distance from any point of each cell [m]
+  std::vector<float> reach_;      ///< wall distance of each cell centre less the hit band [m]
   double minSpacing_;
   double stokesTime_;             ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
   double particleDiameter_;
@@ -56,7 +58,7 @@ class MotionKernel {
   StepVelocityField particleVelocity_;  ///< u_P^rec of the step
   StepVelocityField gasVelocity_;       ///< u_G^rec of the step (free flight only)
   /// Per cell, the two numbers a tracer reads from its own cell, side by side so they cost one cache
-  /// line: [2c] the wall clearance [m] (0 without walls), [2c+1] |u_fluc| of Eq. (10) capped at
+  /// line: [2c] reach_ [m] (0 without walls), [2c+1] |u_fluc| of Eq. (10) capped at
   /// u_fluc_max [m/s] (0 without fluctuation).
   std::vector<float> cellData_;
 };
