@@ -205,6 +205,7 @@ void MotionKernel::move(TracerContext& ctx) {
   g.sy = grid_.shape[0], g.sz = grid_.shape[0] * grid_.shape[1];
   const bool midpoint = settings_.midpoint;
   const bool walls = settings_.walls;
+  const std::int64_t vectorised = settings_.vectorised ? 1 : 0;
 
   // The scalar path: sub-steps, walls within reach, free flight.
   // Counters go through `st`, not captured: a capture would bypass the OpenMP reduction's copies.
@@ -305,7 +306,7 @@ void MotionKernel::move(TracerContext& ctx) {
 #pragma omp simd
     for (int k = 0; k < count; ++k) {
       const double d2 = (ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * (dt * dt);
-      fast[k] = (!scalar[k]) & (d2 <= limit2);
+      fast[k] = (!scalar[k]) & (d2 <= limit2) & vectorised;
     }
     if (midpoint) sampleBlock(locator, field, count, mx, my, mz, ax, ay, az, ux, uy, uz);
     // Walls: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move inside.
