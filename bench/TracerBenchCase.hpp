@@ -4,6 +4,8 @@
 // within 1%), 472,850 tracers, 100 in-memory frames of the swaying spout (SyntheticFields.hpp),
 // dt = dt_rec = 5 ms. --quick: 15 mm cells, 47,285 tracers, 10 frames.
 #include <chrono>
+#include <cstdlib>
+#include <string>
 #include <ctime>
 #include <iostream>
 #include <memory>
@@ -60,7 +62,10 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
                AfterRun after = [](TracerSimulation&) {}) {
   RecurrencePath path;
   for (int k = 0; k < warmup + steps + 2; ++k) path.frames.push_back(k % db->frameCount());
-  TracerSimulation sim(scene, db, path, {1, warmup + steps, 0});
+  // RCFD_BENCH_SCALAR_KERNEL=1: every tracer through the kernel's scalar path (what the block path saves).
+  const char* scalarOnly = std::getenv("RCFD_BENCH_SCALAR_KERNEL");
+  const bool vectorised = !(scalarOnly && std::string(scalarOnly) == "1");
+  TracerSimulation sim(scene, db, path, {1, warmup + steps, 0, vectorised});
   for (int k = 0; k < std::max(1, warmup); ++k) sim.step();
   const double cpu0 = processCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
