@@ -327,13 +327,22 @@ void MotionKernel::move(TracerContext& ctx) {
       const double reach = double(cellData[2 * (ci[0] + ci[1] * g.sy + ci[2] * g.sz)]) + noWall;
       fast[k] = fast[k] & (std::sqrt(off2) + length < reach);
     }
+    double* const bx = px + i0;
+    double* const by = py + i0;
+    double* const bz = pz + i0;
+    double* const bvx = cloud.vx.data() + i0;
+    double* const bvy = cloud.vy.data() + i0;
+    double* const bvz = cloud.vz.data() + i0;
+#pragma omp simd
     for (int k = 0; k < count; ++k) {
-      const std::int64_t i = i0 + k;
-      if (fast[k]) {
-        px[i] += dt * ux[k], py[i] += dt * uy[k], pz[i] += dt * uz[k];
-        cloud.vx[std::size_t(i)] = ux[k], cloud.vy[std::size_t(i)] = uy[k], cloud.vz[std::size_t(i)] = uz[k];
-      } else {
-        moveOne(i, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+      if (fast[k]) {  // masked stores
+        bx[k] += dt * ux[k], by[k] += dt * uy[k], bz[k] += dt * uz[k];
+        bvx[k] = ux[k], bvy[k] = uy[k], bvz[k] = uz[k];
+      }
+    }
+    for (int k = 0; k < count; ++k) {
+      if (!fast[k]) {
+        moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
         ++st.scalarPath;
       }
     }
