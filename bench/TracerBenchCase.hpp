@@ -55,6 +55,7 @@ struct Timing {
   double substepFraction = 0.0;    ///< extra sub-steps per tracer-step (last step)
   double wallHitFraction = 0.0;    ///< reflections per tracer-step (last step)
   double scalarFraction = 0.0;     ///< tracers that took the kernel's scalar path (last step)
+  double wallTestFraction = 0.0;   ///< block-path tracers that needed the exact wall test (last step)
 };
 
 template <class AfterRun = void (*)(TracerSimulation&)>
@@ -78,6 +79,7 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
   t.substepFraction = double(sim.motionStatistics().substeps) / double(scene.rcfd.tracers);
   t.wallHitFraction = double(sim.motionStatistics().wallHits) / double(scene.rcfd.tracers);
   t.scalarFraction = double(sim.motionStatistics().scalarPath) / double(scene.rcfd.tracers);
+  t.wallTestFraction = double(sim.motionStatistics().exactWallTests) / double(scene.rcfd.tracers);
   after(sim);
   return t;
 }

@@ -22,7 +22,8 @@ nlohmann::json runTracers(const Options& options) {
             << headline.cpuSecondsPerStep * 1e3 << " CPU-ms/step, "
             << headline.cpuSecondsPerStep / double(scene.rcfd.tracers) * 1e9 << " CPU-ns/tracer-step; "
             << headline.substepFraction << " extra sub-steps and " << headline.wallHitFraction
-            << " reflections per tracer-step, " << headline.scalarFraction << " on the scalar path)\n";
+            << " reflections per tracer-step, " << headline.scalarFraction << " on the scalar path, "
+            << headline.wallTestFraction << " exact wall tests)\n";
 
   nlohmann::json costs = nlohmann::json::object();
   const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
@@ -51,6 +52,7 @@ nlohmann::json runTracers(const Options& options) {
           {"tracer_steps_per_cpu_s", double(scene.rcfd.tracers) / headline.cpuSecondsPerStep},
           {"tracers", scene.rcfd.tracers},
           {"scalar_path_fraction", headline.scalarFraction},
+          {"exact_wall_test_fraction", headline.wallTestFraction},
           {"substep_fraction", headline.substepFraction},
           {"cells", bench.cells},
           {"effect_costs", costs}};

@@ -178,7 +178,7 @@ void MotionKernel::move(TracerContext& ctx) {
   prepare(ctx, sampler, fluctuate);
   const CounterRngPrefix rngPrefix(ctx.seed, RngPurpose::Fluctuation, std::uint64_t(ctx.step));
   const std::int64_t n = std::int64_t(cloud.size());
-  std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0, scalarPath = 0;
+  std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0, scalarPath = 0, exactWallTests = 0;
   // Sub-steps so that no sub-step moves farther than max_courant cells; a non-finite or enormous
   // displacement gets kMaxSubsteps (the exact wall tests still keep the tracer inside).
   const double cellLimit = settings_.maxCourant * minSpacing_;
@@ -251,7 +251,7 @@ void MotionKernel::move(TracerContext& ctx) {
   double* const px = cloud.x.data();
   double* const py = cloud.y.data();
   double* const pz = cloud.z.data();
-#pragma omp parallel for schedule(static) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath) if (n > kParallelThreshold)
+#pragma omp parallel for schedule(static) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests) if (n > kParallelThreshold)
   for (std::int64_t b = 0; b < blocks; ++b) {
     const std::int64_t i0 = b * kBlock;
     const int count = int(std::min<std::int64_t>(kBlock, n - i0));
@@ -261,7 +261,8 @@ void MotionKernel::move(TracerContext& ctx) {
     alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];  // midpoint
     alignas(64) double speed[kBlock];
     std::int32_t cellOf[kBlock];
-    std::int64_t scalar[kBlock], fast[kBlock];  // flags; not bool, which stops the vectoriser
+    // Flags (not bool, which stops the vectoriser): free flight; one sub-step; move final here.
+    std::int64_t scalar[kBlock], single[kBlock], fast[kBlock];
     // Cells, then their clearance and Eq. (10) speed: independent loads the vectorised loop issues as
     // gathers, so their cache misses overlap.
     if (haveTracerAlpha) {
@@ -306,7 +307,7 @@ void MotionKernel::move(TracerContext& ctx) {
 #pragma omp simd
     for (int k = 0; k < count; ++k) {
       const double d2 = (ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * (dt * dt);
-      fast[k] = (!scalar[k]) & (d2 <= limit2) & vectorised;
+      single[k] = (!scalar[k]) & (d2 <= limit2) & vectorised;
     }
     if (midpoint) sampleBlock(locator, field, count, mx, my, mz, ax, ay, az, ux, uy, uz);
     // Walls: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move inside.
@@ -325,7 +326,7 @@ void MotionKernel::move(TracerContext& ctx) {
         off2 += e * e;
       }
       const double reach = double(cellData[2 * (ci[0] + ci[1] * g.sy + ci[2] * g.sz)]) + noWall;
-      fast[k] = fast[k] & (std::sqrt(off2) + length < reach);
+      fast[k] = single[k] & (std::sqrt(off2) + length < reach);
     }
     double* const bx = px + i0;
     double* const by = py + i0;
@@ -341,19 +342,30 @@ void MotionKernel::move(TracerContext& ctx) {
       }
     }
     for (int k = 0; k < count; ++k) {
-      if (!fast[k]) {
-        moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+      if (fast[k]) continue;
+      const std::int64_t i = i0 + k;
+      if (single[k]) {
+        // One sub-step with a wall within reach: the block's (midpoint) velocity, the exact wall test.
+        Eigen::Vector3d p = cloud.position(std::size_t(i));
+        const Eigen::Vector3d u(ux[k], uy[k], uz[k]);
+        st.wallHits += moveWithWalls(p, dt * u, nullptr, 1.0, walls ? double(clearance_[std::size_t(cellOf[k])]) : -1.0);
+        ++st.exactWallTests;
+        cloud.setPosition(std::size_t(i), p);
+        cloud.setVelocity(std::size_t(i), u);
+      } else {
+        moveOne(i, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
         ++st.scalarPath;
       }
     }
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
-    scalarPath += st.scalarPath;
+    scalarPath += st.scalarPath, exactWallTests += st.exactWallTests;
   }
   stats_.substeps = substeps;
   stats_.wallHits = wallHits;
   stats_.freeFlight = freeFlight;
   stats_.substepCapped = capped;
   stats_.scalarPath = scalarPath;
+  stats_.exactWallTests = exactWallTests;
 }
 
 }  // namespace rcfd

@@ -20,7 +20,8 @@ struct MotionStatistics {
   std::int64_t wallHits = 0;        ///< reflections
   std::int64_t freeFlight = 0;      ///< tracers in free flight
   std::int64_t substepCapped = 0;   ///< tracers that needed more than kMaxSubsteps
-  std::int64_t scalarPath = 0;      ///< tracers moved one by one (sub-steps, a wall within reach, free flight)
+  std::int64_t scalarPath = 0;      ///< tracers moved one by one (sub-steps, free flight)
+  std::int64_t exactWallTests = 0;  ///< block-path tracers with a wall within reach (exact segment test)
 };
 
 class MotionKernel {

@@ -98,16 +98,20 @@ TEST(Kernel, BlockPathMatchesScalarPath) {
   const std::int64_t steps = 40;
   TracerSimulation block(s, db, sequentialPath(6, steps + 2), {5, steps, 0, true});
   TracerSimulation scalar(s, db, sequentialPath(6, steps + 2), {5, steps, 0, false});
-  std::int64_t scalarPathTracers = 0, wallHits = 0;
+  std::int64_t scalarPathTracers = 0, exactWallTests = 0, wallHits = 0;
   for (std::int64_t k = 0; k < steps; ++k) {
     block.step();
     scalar.step();
     scalarPathTracers += block.motionStatistics().scalarPath;
+    exactWallTests += block.motionStatistics().exactWallTests;
     wallHits += block.motionStatistics().wallHits;
     EXPECT_EQ(scalar.motionStatistics().scalarPath, std::int64_t(s.rcfd.tracers));
   }
   // 8000 cells, 27% of them next to a wall: the block path does most of the work.
-  EXPECT_LT(scalarPathTracers, steps * s.rcfd.tracers / 2) << block.motionStatistics().substeps << " sub-steps";
+  EXPECT_LT(scalarPathTracers + exactWallTests, steps * s.rcfd.tracers / 2)
+      << block.motionStatistics().substeps << " sub-steps";
+  EXPECT_GT(scalarPathTracers, 0);  // all three ways a tracer can move were taken
+  EXPECT_GT(exactWallTests, 0);
   EXPECT_GT(wallHits, 0);
   double worst = 0.0;
   for (std::size_t i = 0; i < block.cloud().size(); ++i) {
