@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
+#include "core/Errors.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FluctuationModel.hpp"
 #include "tracers/UnitVectors.hpp"
@@ -17,6 +19,10 @@ double dragFactor(double re) {
 
 MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& settings)
     : settings_(settings), apparatus_(ctx.apparatus), grid_(ctx.grid) {
+  // The block loops index the 4-float step field with int32 (4 x cells < 2^31).
+  if (grid_.cellCount() > std::int64_t(1) << 29) {
+    throw RunError("grid of " + std::to_string(grid_.cellCount()) + " cells: the tracer kernel supports at most 2^29");
+  }
   minSpacing_ = grid_.spacing.minCoeff();
   const auto& p = ctx.scene.particles;
   const auto& g = ctx.scene.gas;
