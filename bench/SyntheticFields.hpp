@@ -66,3 +66,26 @@ inline void syntheticFrame(const CartesianGrid& g, int n, FieldFrame& f) {
 }
 
 }  // namespace rcfd::bench
+
+namespace rcfd::bench {
+
+/// The tracer and spray benchmarks' fields on the ProCell grid: a spout (|x - centre| < 20 mm, y < 0.3 m;
+/// alpha_P 0.1, u_P 2.5 m/s up, u_G 12 m/s up) that sways left and right with period 0.5 s, a bed
+/// (y < 0.15 m; alpha_P 0.55) sliding down and toward the spout, a dilute freeboard (alpha_P 0.01)
+/// falling at 1 m/s, gas at 2 m/s outside the spout.
+inline void swayingSpout(const CartesianGrid& grid, int, double t, FieldFrame& f) {
+  const double centre = 0.02 * std::sin(2 * M_PI * t / 0.5);
+  for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+    const auto ijk = grid.cellIjk(c);
+    const auto p = grid.cellCenter(ijk[0], ijk[1], ijk[2]);
+    const double dx = p.x() - centre;
+    const bool spout = std::abs(dx) < 0.02 && p.y() < 0.3;
+    const bool bed = p.y() < 0.15;
+    f.alpha_p[std::size_t(c)] = float(spout ? 0.1 : (bed ? 0.55 : 0.01));
+    f.u_p[std::size_t(3 * c)] = float(spout ? 0.2 * dx / 0.02 : (bed ? -0.1 * std::copysign(1.0, dx) : 0.0));
+    f.u_p[std::size_t(3 * c + 1)] = float(spout ? 2.5 : (bed ? -0.15 : -1.0));
+    f.u_g[std::size_t(3 * c + 1)] = float(spout ? 12.0 : 2.0);
+  }
+}
+
+}  // namespace rcfd::bench

@@ -30,11 +30,22 @@ enum class RngPurpose : std::uint64_t {
   Deposition = 6,
 };
 
+/// The part of a CounterRng key shared by every stream of one (seed, purpose, step), hoisted out of
+/// loops over tracers: CounterRng(prefix, stream) draws exactly the numbers of
+/// CounterRng(seed, purpose, stream, step).
+struct CounterRngPrefix {
+  CounterRngPrefix(std::uint64_t seed, RngPurpose purpose, std::uint64_t step)
+      : head(mix64(mix64(seed ^ 0x5851f42d4c957f2dULL) + std::uint64_t(purpose))),
+        tail(mix64(step + 0x632be59bd9b4e019ULL)) {}
+  std::uint64_t head, tail;
+};
+
 class CounterRng {
  public:
   CounterRng(std::uint64_t seed, RngPurpose purpose, std::uint64_t stream, std::uint64_t step)
-      : key_(mix64(mix64(mix64(seed ^ 0x5851f42d4c957f2dULL) + std::uint64_t(purpose)) + stream) ^
-             mix64(step + 0x632be59bd9b4e019ULL)) {}
+      : CounterRng(CounterRngPrefix(seed, purpose, step), stream) {}
+  CounterRng(const CounterRngPrefix& prefix, std::uint64_t stream)
+      : key_(mix64(prefix.head + stream) ^ prefix.tail) {}
 
   std::uint64_t nextU64() { return mix64(key_ + 0x9e3779b97f4a7c15ULL * (++counter_)); }
   /// Uniform in [0, 1) with 53 random bits.

@@ -1,14 +1,17 @@
 #pragma once
 /// \file FrameSampler.hpp
-/// Reads recurrence fields at tracer positions: cell values and trilinear interpolation between cell
+/// Reads recurrence fields at arbitrary points: cell values and trilinear interpolation between cell
 /// centres (constant extrapolation beyond the outermost centres), optionally blended linearly between
-/// two consecutive frames of a sequence when the tracer time step is smaller than dt_rec.
+/// two consecutive frames of a sequence when the tracer time step is smaller than dt_rec. The tracer
+/// motion kernel uses its own per-step copy of the velocity (tracers/StepField.hpp); this class serves
+/// the effects that sample a few points (probes, spray parcels, averages).
 
 #include <algorithm>
 #include <cmath>
 
 #include "fields/FieldDatabase.hpp"
 #include "geometry/CartesianGrid.hpp"
+#include "tracers/Trilinear.hpp"
 
 namespace rcfd {
 
@@ -16,11 +19,12 @@ class FrameSampler {
  public:
   FrameSampler(const CartesianGrid& grid, const FieldFrame* frame, const FieldFrame* next = nullptr,
                double blend = 0.0)
-      : grid_(grid), a_(frame), b_(next && blend > 0.0 ? next : nullptr), w_(blend) {
-    for (int d = 0; d < 3; ++d) inv_[d] = 1.0 / grid.spacing[d];
-  }
+      : locator_(grid), a_(frame), b_(next && blend > 0.0 ? next : nullptr), w_(blend) {}
 
   const FieldFrame& frame() const { return *a_; }
+  const FieldFrame* nextFrame() const { return b_; }
+  double blend() const { return b_ ? w_ : 0.0; }
+  const TrilinearLocator& locator() const { return locator_; }
 
   /// alpha_P^rec of a cell.
   double alphaP(std::int64_t cell) const {
@@ -30,43 +34,23 @@ class FrameSampler {
 
   /// u_P^rec (useGas = false) or u_G^rec (useGas = true) at p, trilinear between cell centres.
   Eigen::Vector3d velocity(const Eigen::Vector3d& p, bool useGas) const {
-    int i0[3], i1[3];
-    double f[3];
-    for (int d = 0; d < 3; ++d) {
-      const int n = grid_.shape[d];
-      double s = (p[d] - grid_.origin[d]) * inv_[d] - 0.5;
-      s = std::clamp(s, 0.0, double(n - 1));
-      int lo = std::min(int(s), std::max(n - 2, 0));
-      i0[d] = lo;
-      i1[d] = std::min(lo + 1, n - 1);
-      f[d] = s - lo;
+    const TrilinearStencil s = locator_.locate(p);
+    const float* fa = (useGas ? a_->u_g : a_->u_p).data();
+    const float* fb = b_ ? (useGas ? b_->u_g : b_->u_p).data() : nullptr;
+    Eigen::Vector3d corners[8];
+    for (int c = 0; c < 8; ++c) {
+      const std::size_t at = std::size_t(3 * (s.base + locator_.offset(c)));
+      corners[c] = Eigen::Vector3d(fa[at], fa[at + 1], fa[at + 2]);
+      if (fb) corners[c] += w_ * (Eigen::Vector3d(fb[at], fb[at + 1], fb[at + 2]) - corners[c]);
     }
-    Eigen::Vector3d u = sampleCorners(useGas ? a_->u_g : a_->u_p, i0, i1, f);
-    if (b_) u += w_ * (sampleCorners(useGas ? b_->u_g : b_->u_p, i0, i1, f) - u);
-    return u;
+    return trilinear(corners, s.f);
   }
 
  private:
-  Eigen::Vector3d sampleCorners(const std::vector<float>& field, const int* i0, const int* i1,
-                                const double* f) const {
-    Eigen::Vector3d u = Eigen::Vector3d::Zero();
-    for (int c = 0; c < 8; ++c) {
-      const int i = (c & 1) ? i1[0] : i0[0];
-      const int j = (c & 2) ? i1[1] : i0[1];
-      const int k = (c & 4) ? i1[2] : i0[2];
-      const double w = ((c & 1) ? f[0] : 1.0 - f[0]) * ((c & 2) ? f[1] : 1.0 - f[1]) *
-                       ((c & 4) ? f[2] : 1.0 - f[2]);
-      const float* v = field.data() + 3 * grid_.flatIndex(i, j, k);
-      u += w * Eigen::Vector3d(v[0], v[1], v[2]);
-    }
-    return u;
-  }
-
-  const CartesianGrid& grid_;
+  TrilinearLocator locator_;
   const FieldFrame* a_;
   const FieldFrame* b_;
   double w_;
-  double inv_[3];
 };
 
 }  // namespace rcfd

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
@@ -19,6 +20,8 @@ struct MotionStatistics {
   std::int64_t wallHits = 0;        ///< reflections
   std::int64_t freeFlight = 0;      ///< tracers in free flight
   std::int64_t substepCapped = 0;   ///< tracers that needed more than kMaxSubsteps
+  std::int64_t scalarPath = 0;      ///< tracers moved one by one (sub-steps, free flight)
+  std::int64_t exactWallTests = 0;  ///< block-path tracers with a wall within reach (exact segment test)
 };
 
 class MotionKernel {
@@ -34,20 +37,31 @@ class MotionKernel {
 
   /// Moves p by disp, reflecting at walls (mirror of the remaining displacement); v is reflected with
   /// the restitution coefficient if `velocity` is non-null. Returns the number of reflections.
+  /// `clearance`, if >= 0, is the wall clearance of p's cell (saves looking it up).
   int moveWithWalls(Eigen::Vector3d& p, Eigen::Vector3d disp, Eigen::Vector3d* velocity,
-                    double restitution) const;
+                    double restitution, double clearance = -1.0) const;
 
  private:
+  /// Builds the step's velocity fields and cell table from the context's frames and tracer alpha_P.
+  void prepare(const TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
+
   MotionSettings settings_;
   const Apparatus& apparatus_;
   const CartesianGrid& grid_;
   std::vector<float> clearance_;  ///< lower bound of the wall distance from any point of each cell [m]
+  std::vector<float> reach_;      ///< wall distance of each cell centre less the hit band [m]
   double minSpacing_;
   double stokesTime_;             ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
   double particleDiameter_;
   double gasViscosity_;
   Eigen::Vector3d gravity_{0.0, -9.81, 0.0};
   MotionStatistics stats_;
+  StepVelocityField particleVelocity_;  ///< u_P^rec of the step
+  StepVelocityField gasVelocity_;       ///< u_G^rec of the step (free flight only)
+  /// Per cell, the two numbers a tracer reads from its own cell, side by side so they cost one cache
+  /// line: [2c] reach_ [m] (0 without walls), [2c+1] |u_fluc| of Eq. (10) capped at
+  /// u_fluc_max [m/s] (0 without fluctuation).
+  std::vector<float> cellData_;
 };
 
 }  // namespace rcfd

@@ -34,6 +34,7 @@ struct MotionSettings {
   double maxCourant = 1.0;       ///< particle Courant bound for sub-steps [-]
   bool midpoint = true;          ///< Eq. (9) by the midpoint rule (2nd order) instead of Euler
   double wallRestitution = 0.75; ///< normal restitution of free-flying tracers at walls [-]
+  bool vectorised = true;        ///< false: every tracer through the scalar path (tests compare both)
 };
 
 class TracerEffect {

@@ -56,6 +56,7 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   placeTracers();
 
   MotionSettings motion;
+  motion.vectorised = settings_.vectorisedKernel;
   for (const auto& name : effects) {
     effects_.push_back(TracerEffectRegistry::entries().at(name).factory(ctx));
     effects_.back()->configureMotion(motion);

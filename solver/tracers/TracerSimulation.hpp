@@ -21,6 +21,7 @@ struct TracerRunSettings {
   std::uint64_t seed = 1;
   std::int64_t steps = 0;         ///< planned number of steps
   std::int64_t discardSteps = 0;  ///< statistics start at this step
+  bool vectorisedKernel = true;   ///< false: the motion kernel's scalar path for every tracer (tests)
 };
 
 class TracerSimulation {

@@ -1,7 +1,11 @@
 // tracer_volume_fraction: maps the tracers to the grid at the start of every step. alpha_P of a cell is
 // (tracers in the cell) x (particle volume per tracer) / (open volume of the cell). Counting is integer
-// and therefore the same for any thread count.
+// and therefore the same for any thread count. Each thread counts its share of the tracers into its own
+// histogram (no atomics: a locked increment per tracer cost more than the rest of this pass), and the
+// histograms are summed per cell.
+#include <algorithm>
 #include <memory>
+#include <omp.h>
 
 #include "tracers/TracerEffect.hpp"
 
@@ -17,24 +21,62 @@ class TracerVolumeFractionEffect final : public TracerEffect {
     bytes_ = ctx.tracerCell.size() * sizeof(std::int32_t) + ctx.tracerCount.size() * sizeof(std::int32_t) +
              ctx.tracerAlpha.size() * sizeof(float);
   }
-  std::size_t allocatedBytes() const override { return bytes_; }
+  std::size_t allocatedBytes() const override { return bytes_ + partial_.capacity() * sizeof(std::int32_t); }
 
   void beforeMove(TracerContext& ctx) override {
     const auto& cloud = ctx.cloud;
     auto& count = ctx.tracerCount;
-    std::fill(count.begin(), count.end(), 0);
     const std::int64_t n = std::int64_t(cloud.size());
-#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
-    for (std::int64_t i = 0; i < n; ++i) {
-      const auto c = std::int32_t(ctx.grid.flatIndexOf(cloud.position(std::size_t(i))));
-      ctx.tracerCell[std::size_t(i)] = c;
-#pragma omp atomic
-      ++count[std::size_t(c)];
-    }
-    const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
     const std::int64_t cells = ctx.grid.cellCount();
+    const bool parallel = n > kParallelThreshold;
+    const int threads = parallel ? omp_get_max_threads() : 1;
+    partial_.resize(std::size_t(threads - 1) * std::size_t(cells));
+    int used = 1;  // a team may be smaller than asked for (nested inside a calibration's threads)
+#pragma omp parallel if (parallel) num_threads(threads)
+    {
+      const int t = omp_get_thread_num();
+#pragma omp single
+      used = omp_get_num_threads();
+      std::int32_t* histogram = t == 0 ? count.data() : partial_.data() + std::size_t(t - 1) * std::size_t(cells);
+      std::fill(histogram, histogram + cells, 0);
+      // The cell of every tracer: CartesianGrid::cellOf's arithmetic on plain locals, which vectorises.
+      const double* x = cloud.x.data();
+      const double* y = cloud.y.data();
+      const double* z = cloud.z.data();
+      std::int32_t* cellOut = ctx.tracerCell.data();
+      const double ox = ctx.grid.origin.x(), oy = ctx.grid.origin.y(), oz = ctx.grid.origin.z();
+      const double hx = ctx.grid.spacing.x(), hy = ctx.grid.spacing.y(), hz = ctx.grid.spacing.z();
+      const int nx = ctx.grid.shape[0], ny = ctx.grid.shape[1], nz = ctx.grid.shape[2];
+      constexpr std::int64_t kBlock = 256;  // blocks of plain int loops: what GCC's vectoriser takes
+#pragma omp for schedule(static)
+      for (std::int64_t b = 0; b < (n + kBlock - 1) / kBlock; ++b) {
+        const std::int64_t i0 = b * kBlock;
+        const int count = int(std::min(kBlock, n - i0));
+        const double* bx = x + i0;
+        const double* by = y + i0;
+        const double* bz = z + i0;
+        std::int32_t* out = cellOut + i0;
+#pragma omp simd
+        for (int k = 0; k < count; ++k) {
+          // int(floor(t)) as truncation corrected for negative t (the same integer; floor itself does
+          // not vectorise under GCC's default trapping-math).
+          const double tx = (bx[k] - ox) / hx, ty = (by[k] - oy) / hy, tz = (bz[k] - oz) / hz;
+          int ci = int(tx), cj = int(ty), ck = int(tz);
+          ci -= double(ci) > tx, cj -= double(cj) > ty, ck -= double(ck) > tz;
+          ci = ci < 0 ? 0 : (ci >= nx ? nx - 1 : ci);
+          cj = cj < 0 ? 0 : (cj >= ny ? ny - 1 : cj);
+          ck = ck < 0 ? 0 : (ck >= nz ? nz - 1 : ck);
+          out[k] = (ck * ny + cj) * nx + ci;
+        }
+      }
+#pragma omp for schedule(static)
+      for (std::int64_t i = 0; i < n; ++i) ++histogram[cellOut[i]];
+    }
+    const int others = used - 1;
+    const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
 #pragma omp parallel for schedule(static) if (cells > kParallelThreshold)
     for (std::int64_t c = 0; c < cells; ++c) {
+      for (int t = 0; t < others; ++t) count[std::size_t(c)] += partial_[std::size_t(t) * std::size_t(cells) + std::size_t(c)];
       const double open = ctx.openVolume[std::size_t(c)];
       ctx.tracerAlpha[std::size_t(c)] =
           open > 0.0 ? float(count[std::size_t(c)] * volumePerTracer / open) : 0.0f;
@@ -43,6 +85,7 @@ class TracerVolumeFractionEffect final : public TracerEffect {
 
  private:
   std::size_t bytes_ = 0;
+  std::vector<std::int32_t> partial_;  ///< histograms of threads 1.. (thread 0 counts into tracerCount)
 };
 
 const bool registered = TracerEffectRegistry::add(

@@ -1,0 +1,87 @@
+#pragma once
+// The paper-scale tracer case shared by `rcfd-bench tracers` and `rcfd-bench spray`: the ProCell
+// apparatus (250 x 600 x 200 mm) on 7.4 mm cells (34 x 81 x 27 = 74,358 cells, the paper's 73,647
+// within 1%), 472,850 tracers, 100 in-memory frames of the swaying spout (SyntheticFields.hpp),
+// dt = dt_rec = 5 ms. --quick: 15 mm cells, 47,285 tracers, 10 frames.
+#include <chrono>
+#include <cstdlib>
+#include <string>
+#include <ctime>
+#include <iostream>
+#include <memory>
+
+#include "BenchRegistry.hpp"
+#include "SyntheticFields.hpp"
+#include "fields/AnalyticDatabase.hpp"
+#include "geometry/Apparatus.hpp"
+#include "tracers/TracerSimulation.hpp"
+
+namespace rcfd::bench {
+
+inline double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+struct TracerBenchCase {
+  Scene scene;  // ProCell defaults
+  std::shared_ptr<FieldDatabase> db;
+  std::int64_t cells = 0;
+
+  explicit TracerBenchCase(const Options& options) {
+    const double cell = options.quick ? 0.015 : 0.0074;  // 0.0074 m -> about 74k cells
+    scene.grid.cell_size = Vec3(cell, cell, cell);
+    scene.rcfd.tracers = options.quick ? 47285 : 472850;
+    scene.rcfd.d0 = 5e-4;
+    Apparatus apparatus(scene.apparatus);
+    const CartesianGrid grid = makeGrid(apparatus, scene.grid);
+    const auto open = openFractions(apparatus, grid);
+    const std::vector<float> fluid(open.begin(), open.end());
+    const int frames = options.quick ? 10 : 100;
+    cells = grid.cellCount();
+    std::cerr << "grid " << grid.shape[0] << " x " << grid.shape[1] << " x " << grid.shape[2] << " = "
+              << grid.cellCount() << " cells, " << scene.rcfd.tracers << " tracers, " << frames << " frames\n";
+    db = makeAnalyticDatabase(grid, fluid, scene.rcfd.dt, frames,
+                              [&](int n, double t, FieldFrame& f) { swayingSpout(grid, n, t, f); });
+  }
+};
+
+/// Wall and CPU time of `steps` steps after `warmup` untimed ones (at least one: first-touch pages).
+struct Timing {
+  double secondsPerStep = 0.0;
+  double tracerStepsPerSecond = 0.0;
+  double cpuSecondsPerStep = 0.0;  ///< process CPU time (all threads) per step: what the load distorts least
+  double substepFraction = 0.0;    ///< extra sub-steps per tracer-step (last step)
+  double wallHitFraction = 0.0;    ///< reflections per tracer-step (last step)
+  double scalarFraction = 0.0;     ///< tracers that took the kernel's scalar path (last step)
+  double wallTestFraction = 0.0;   ///< block-path tracers that needed the exact wall test (last step)
+};
+
+template <class AfterRun = void (*)(TracerSimulation&)>
+Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup, int steps,
+               AfterRun after = [](TracerSimulation&) {}) {
+  RecurrencePath path;
+  for (int k = 0; k < warmup + steps + 2; ++k) path.frames.push_back(k % db->frameCount());
+  // RCFD_BENCH_SCALAR_KERNEL=1: every tracer through the kernel's scalar path (what the block path saves).
+  const char* scalarOnly = std::getenv("RCFD_BENCH_SCALAR_KERNEL");
+  const bool vectorised = !(scalarOnly && std::string(scalarOnly) == "1");
+  TracerSimulation sim(scene, db, path, {1, warmup + steps, 0, vectorised});
+  for (int k = 0; k < std::max(1, warmup); ++k) sim.step();
+  const double cpu0 = processCpuSeconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < steps; ++k) sim.step();
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Timing t;
+  t.secondsPerStep = s / steps;
+  t.cpuSecondsPerStep = (processCpuSeconds() - cpu0) / steps;
+  t.tracerStepsPerSecond = double(scene.rcfd.tracers) / t.secondsPerStep;
+  t.substepFraction = double(sim.motionStatistics().substeps) / double(scene.rcfd.tracers);
+  t.wallHitFraction = double(sim.motionStatistics().wallHits) / double(scene.rcfd.tracers);
+  t.scalarFraction = double(sim.motionStatistics().scalarPath) / double(scene.rcfd.tracers);
+  t.wallTestFraction = double(sim.motionStatistics().exactWallTests) / double(scene.rcfd.tracers);
+  after(sim);
+  return t;
+}
+
+}  // namespace rcfd::bench

@@ -1,0 +1,56 @@
+#pragma once
+/// \file StepField.hpp
+/// A recurrence velocity field prepared for one tracer step: 4 floats per cell (x, y, z, 0), 16-byte
+/// aligned, blended between the step's two frames once per cell rather than once per tracer and
+/// corner. The motion kernel then fetches a corner with one aligned load. Rebuilding costs one pass
+/// over the cells (74k) per step against 8-16 corner loads for each of the 473k tracers.
+/// Blended values are rounded to float, the precision the database stores frames in.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "tracers/FrameSampler.hpp"
+
+namespace rcfd {
+
+class StepVelocityField {
+ public:
+  /// Fills the field from the sampler's frame(s): u_P^rec, or u_G^rec when useGas.
+  void build(const FrameSampler& sampler, bool useGas, bool parallel) {
+    const auto& fa = useGas ? sampler.frame().u_g : sampler.frame().u_p;
+    const FieldFrame* next = sampler.nextFrame();
+    const float* fb = next ? (useGas ? next->u_g : next->u_p).data() : nullptr;
+    const double w = sampler.blend();
+    const std::int64_t cells = std::int64_t(fa.size() / 3);
+    data_.resize(std::size_t(cells));
+#pragma omp parallel for schedule(static) if (parallel)
+    for (std::int64_t c = 0; c < cells; ++c) {
+      const float* a = fa.data() + 3 * c;
+      Eigen::Array4f& out = data_[std::size_t(c)];
+      if (fb) {
+        const float* b = fb + 3 * c;
+        for (int d = 0; d < 3; ++d) out[d] = float(double(a[d]) + w * (double(b[d]) - double(a[d])));
+      } else {
+        out[0] = a[0], out[1] = a[1], out[2] = a[2];
+      }
+      out[3] = 0.0f;
+    }
+  }
+
+  /// The 8 corners of a stencil with low corner `base`, in double (lane 3 is 0).
+  void gather(std::int64_t base, const TrilinearLocator& locator, Eigen::Array4d* corners) const {
+    for (int c = 0; c < 8; ++c) corners[c] = data_[std::size_t(base + locator.offset(c))].cast<double>();
+  }
+
+  /// The field as 4 floats per cell (x, y, z, 0).
+  const float* floats() const { return data_.empty() ? nullptr : data_[0].data(); }
+
+  std::size_t bytes() const { return data_.capacity() * sizeof(Eigen::Array4f); }
+
+ private:
+  std::vector<Eigen::Array4f> data_;
+};
+
+}  // namespace rcfd
