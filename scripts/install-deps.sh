@@ -10,6 +10,7 @@ packages=(
   nlohmann-json3-dev     # JSON
   libvalijson-dev        # JSON Schema (draft 7) validation
   libsqlite3-dev sqlite3 # job store
+  jq                     # composes job files in scripts/pipeline.sh (the README main command)
   libcli11-dev           # command lines
   libspdlog-dev          # logging
   libgtest-dev libgmock-dev  # tests
