@@ -28,6 +28,10 @@ class File;
 }
 namespace gas {
 class GasSolver;
+struct GasOptions;
+}
+namespace coupling {
+class FluidCoupling;
 }
 
 /// Figures of the last coupling step.
@@ -45,6 +49,9 @@ class CfdDemSimulation {
   /// lists `gas`, the gas solver and coupling (`drag`, `smoothing` select their stages). Throws
   /// InputError naming the scene field on an inconsistent set-up.
   CfdDemSimulation(const Scene& scene, std::uint64_t seed);
+  /// The same with gas-solver options that are not in the scene (verification set-ups: a box with a
+  /// bottom inlet, slip walls). The gas gravity is always the DEM's.
+  CfdDemSimulation(const Scene& scene, std::uint64_t seed, const gas::GasOptions& gasOptions);
   ~CfdDemSimulation();
 
   /// Inserts the scene's bed mass as parcels and lets it settle (DEM only, gas off), at most
@@ -86,6 +93,8 @@ class CfdDemSimulation {
   void loadState(const h5::File& file, const std::string& group);
 
   const CfdDemStepStats& lastStep() const { return last_; }
+  /// The coupling (mapping, drag, exchange sums); null without `gas`.
+  const coupling::FluidCoupling* fluidCoupling() const;
 
  private:
   struct Coupling;  // volume mapping, drag, exchange (cfddem/coupling/)

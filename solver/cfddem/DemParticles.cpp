@@ -11,6 +11,7 @@ std::size_t DemParticles::add(const Vec3& pos, const Vec3& vel, double r, double
   omega.push_back(Vec3::Zero());
   force.push_back(Vec3::Zero());
   torque.push_back(Vec3::Zero());
+  fluid_force.push_back(Vec3::Zero());
   radius.push_back(r);
   mass.push_back(m);
   inv_mass.push_back(1.0 / m);
@@ -31,13 +32,14 @@ void applyPermutation(std::vector<T>& a, const std::vector<std::size_t>& perm) {
 void DemParticles::permute(const std::vector<std::size_t>& perm) {
   applyPermutation(x, perm); applyPermutation(v, perm); applyPermutation(omega, perm);
   applyPermutation(force, perm); applyPermutation(torque, perm); applyPermutation(radius, perm);
+  applyPermutation(fluid_force, perm);
   applyPermutation(mass, perm); applyPermutation(inv_mass, perm); applyPermutation(inv_inertia, perm);
   applyPermutation(id, perm);
 }
 
 void DemParticles::reserve(std::size_t n) {
   id.reserve(n);
-  x.reserve(n); v.reserve(n); omega.reserve(n); force.reserve(n); torque.reserve(n);
+  x.reserve(n); v.reserve(n); omega.reserve(n); force.reserve(n); torque.reserve(n); fluid_force.reserve(n);
   radius.reserve(n); mass.reserve(n); inv_mass.reserve(n); inv_inertia.reserve(n);
 }
 

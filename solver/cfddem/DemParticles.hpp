@@ -40,6 +40,9 @@ class DemParticles {
   std::vector<Vec3> omega;    ///< angular velocity [rad/s]
   std::vector<Vec3> force;    ///< force accumulator of the current step [N]
   std::vector<Vec3> torque;   ///< torque accumulator of the current step [N m]
+  /// Force of the gas on the parcel (drag + pressure gradient) [N], set by the CFD-DEM coupling once
+  /// per coupling step and added in every DEM force gather; zero without gas.
+  std::vector<Vec3> fluid_force;
   std::vector<double> radius; ///< [m] (parcel radius cg r_P for coarse-grained parcels)
   std::vector<double> mass;   ///< [kg]
   std::vector<double> inv_mass;     ///< 1/m [1/kg]

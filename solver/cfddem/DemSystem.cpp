@@ -51,7 +51,7 @@ std::size_t DemSystem::addParticle(const Vector3d& x, const Vector3d& v) {
   const std::size_t i = particles_.add(x, v, material_.particle_radius, material_.density);
   // Until the next force evaluation a new particle feels gravity only (it is inserted clear of
   // others); the particles already there keep their forces, so no contact history is advanced twice.
-  particles_.force[i] = particles_.mass[i] * settings_.gravity;
+  particles_.force[i] = particles_.mass[i] * settings_.gravity + particles_.fluid_force[i];
   particles_.torque[i].setZero();
   return i;
 }
@@ -127,7 +127,7 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   ctx.direct = settings_.serial_direct_accumulation && omp_get_max_threads() == 1;
   if (ctx.direct)
     for (long i = 0; i < n; ++i) {
-      p.force[i] = p.mass[i] * g;
+      p.force[i] = p.mass[i] * g + p.fluid_force[i];
       p.torque[i].setZero();
     }
   model_->computePairs(ctx);
@@ -135,13 +135,13 @@ void DemSystem::computeForces(bool final_kick, int moved) {
   const bool gather_pairs = !ctx.direct;
   double max_overlap = 0.0;
   long wall_contacts = 0;
-  // Gather in a fixed order (gravity + own row, then pairs as second member, then walls):
+  // Gather in a fixed order (gravity + fluid force + own row, then pairs as second member, then walls):
   // independent of the thread count. The second half kick of velocity Verlet is fused into the same loop.
 #pragma omp parallel for schedule(static) reduction(max : max_overlap) reduction(+ : wall_contacts) if (n >= kDemParallelMinParticles)
   for (long i = 0; i < n; ++i) {
     Vector3d f, t;
     if (gather_pairs) {
-      f = p.mass[i] * g + p.force[i];  // own row, summed by the pair loop
+      f = p.mass[i] * g + p.fluid_force[i] + p.force[i];  // own row, summed by the pair loop
       t = p.torque[i];
       for (auto c = list_.col_start[i]; c < list_.col_start[i + 1]; ++c) {
         const auto q = list_.col_pair[c];

@@ -19,6 +19,10 @@
 
 namespace rcfd {
 
+namespace h5 {
+class File;
+}
+
 /// Smaller systems are never sorted: they fit in cache, and tests address particles by index.
 inline constexpr long kDemSortMinParticles = 1024;
 
@@ -81,6 +85,13 @@ class DemSystem {
 
   void step();
   void run(long steps);
+
+  /// Whole state (particles with ids, fluid forces, neighbour list with the tangential contact
+  /// history of pairs and walls, clock) into / from group of a checkpoint file (DemState.cpp): a
+  /// loaded system continues bit-identically to the saved one. The system loaded into must have been
+  /// built with the same material, walls and settings.
+  void saveState(h5::File& file, const std::string& group) const;
+  void loadState(const h5::File& file, const std::string& group);
 
   double time() const { return time_; }
   long steps() const { return steps_; }

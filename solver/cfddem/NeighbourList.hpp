@@ -45,6 +45,13 @@ class NeighbourList {
   std::size_t pairs() const { return j.size(); }
   long builds() const { return builds_; }
 
+  /// Checkpoints: the list's public arrays are saved as they are; this restores the rest (positions at
+  /// the last build and the build count), so a restored list rebuilds exactly when the original would.
+  void restore(std::vector<Eigen::Vector3d> x_at_build, long builds) {
+    x_at_build_ = std::move(x_at_build);
+    builds_ = builds;
+  }
+
   std::vector<Index> row_start;  ///< pairs of particle i are [row_start[i], row_start[i+1])
   std::vector<Index> j;          ///< second member of each pair (j > i)
   std::vector<Eigen::Vector3d> shear;  ///< tangential history per pair [m]

@@ -57,6 +57,9 @@ GasSolver::GasSolver(const Scene& scene, const Apparatus& apparatus, const Carte
   ap_ = computeFaceApertures(apparatus_, grid_);
   buildTopology();
   buildNozzle();
+  source0_ = source_;
+  inletVelocity0_ = inletVelocity_;
+  nozzleJetVelocity0_ = nozzleJetVelocity_;
 }
 
 GasSolver::~GasSolver() = default;

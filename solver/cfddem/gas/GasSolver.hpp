@@ -24,6 +24,10 @@
 #include "geometry/CartesianGrid.hpp"
 #include "scene/Scene.hpp"
 
+namespace rcfd::h5 {
+class File;
+}
+
 namespace rcfd::gas {
 
 /// Settings that are not in the scene (solver choices and verification set-ups).
@@ -78,6 +82,20 @@ class GasSolver {
 
   /// Advances by one step of at most maxDt (and the scene's CFL and max_time_step); returns the dt taken.
   double step(double maxDt);
+  /// The step step() would take without a caller's bound: the scene's max_time_step, the CFL limit of
+  /// the current velocities (and the nozzle jet), the viscous and nozzle-source limits [s]. Depends on
+  /// the alpha_G set for the next step.
+  double stableTimeStep() const;
+  /// Scales the inlet velocity and the nozzle source (and jet velocity) by factor in [0, 1] from the
+  /// next step on: the database job ramps the gas up. Throws RunError outside [0, 1].
+  void setFlowFactor(double factor);
+  double flowFactor() const { return flowFactor_; }
+
+  /// Whole state (face velocities, pressure and its warm start, alpha_G, sources, clock) into / from
+  /// group of a checkpoint file. The pressure preconditioner is rebuilt at the first step after a
+  /// load (so a continued run agrees with an uninterrupted one to the pressure tolerance, not bitwise).
+  void saveState(h5::File& file, const std::string& group) const;
+  void loadState(const h5::File& file, const std::string& group);
   const GasStepStats& lastStep() const { return last_; }
   double time() const { return time_; }
 
@@ -150,6 +168,9 @@ class GasSolver {
   std::vector<double> source_;    ///< nozzle volume source per unit volume s_c [1/s]
   double nozzleJetVelocity_ = 0.0;
   double inletVelocity_ = 0.0;
+  std::vector<double> source0_;   ///< nozzle source at flow factor 1
+  double nozzleJetVelocity0_ = 0.0, inletVelocity0_ = 0.0;
+  double flowFactor_ = 1.0;
   std::vector<double> p_;
   Eigen::VectorXd q_;             ///< p dt / rho of the last solve (warm start)
   std::unique_ptr<PressureSolver> pressureSolver_;

@@ -1,0 +1,158 @@
+// Two-way coupling of DEM and gas: mapping, drag, exchange, fluid forces (FluidCoupling.hpp).
+
+#include "cfddem/coupling/FluidCoupling.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "core/Errors.hpp"
+
+namespace rcfd::coupling {
+
+/// Below this alpha_G a cell is treated as a failure of the over-packing treatment, not as physics.
+constexpr double kMinGasFraction = 0.2;
+
+FluidCoupling::FluidCoupling(const Scene& scene, gas::GasSolver& gas, DemSystem& dem, FluidCouplingOptions options)
+    : scene_(scene), gas_(gas), dem_(dem), options_(std::move(options)) {
+  try {
+    model_ = DragModelRegistry::create(options_.dragModel, scene_);
+  } catch (const std::out_of_range& e) {
+    throw InputError("scene", "/effects", std::string("drag model: ") + e.what());
+  }
+  mapping_ = std::make_unique<VolumeMapping>(gas_.grid(), gas_.openFraction(), gas_.activeCells());
+  if (options_.smoothingLength > 0)
+    smoother_ = std::make_unique<FieldSmoother>(*mapping_, gas_.faceKinds(0), gas_.faceKinds(1), gas_.faceKinds(2),
+                                                options_.smoothingLength);
+  const std::size_t cells = std::size_t(gas_.grid().cellCount());
+  alphaP_.assign(cells, 0.0);
+  alphaG_.assign(cells, 1.0);
+  beta_.assign(cells, 0.0);
+  uP_.assign(cells, Eigen::Vector3d::Zero());
+}
+
+std::vector<Eigen::Vector3d> FluidCoupling::gasVelocitySeen() const {
+  std::vector<Eigen::Vector3d> u = gas_.cellVelocity();
+  if (smoother_) smoother_->smooth(u);  // the adjoint of smoothing the exchange fields
+  return u;
+}
+
+void FluidCoupling::prepare() {
+  const DemParticles& p = dem_.particles();
+  const std::size_t n = p.size(), cells = alphaP_.size();
+  mapping_->weightsOf(p, weights_);
+  mapping_->scatterVolume(p, weights_, volume_);
+  if (smoother_) {
+    for (std::size_t c = 0; c < cells; ++c)
+      alphaP_[c] = mapping_->usable()[c] ? volume_[c] / mapping_->openVolume(c) : 0.0;
+    smoother_->smooth(alphaP_);
+    for (std::size_t c = 0; c < cells; ++c) volume_[c] = alphaP_[c] * mapping_->openVolume(c);
+  }
+  redistributed_ = mapping_->redistributeExcess(volume_, options_.maxParticleFraction);
+  alphaP_ = mapping_->fractionOf(volume_);
+  for (std::size_t c = 0; c < cells; ++c) {
+    alphaG_[c] = mapping_->usable()[c] ? 1.0 - alphaP_[c] : 1.0;
+    if (!(alphaG_[c] >= kMinGasFraction)) {
+      const auto ijk = gas_.grid().cellIjk(std::int64_t(c));
+      std::ostringstream s;
+      s << "coupling: alpha_P = " << alphaP_[c] << " in cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2]
+        << ") at t = " << dem_.time() << " s after the over-packing redistribution (limit "
+        << options_.maxParticleFraction << "): the cell has no open neighbour to take the excess";
+      throw RunError(s.str());
+    }
+  }
+  gas_.setGasFraction(alphaG_);
+
+  k_.assign(n, 0.0);
+  std::fill(beta_.begin(), beta_.end(), 0.0);
+  std::fill(uP_.begin(), uP_.end(), Eigen::Vector3d::Zero());
+  if (options_.drag) {
+    const std::vector<Eigen::Vector3d> u = gasVelocitySeen();
+    const double cg = scene_.dem.coarse_graining, d = scene_.particles.diameter;
+    const double nu = scene_.gas.kinematic_viscosity, mu = scene_.gas.density * nu;
+    const double stokes = cg * cg * cg * 3.0 * std::numbers::pi * mu * d;
+    const long ln = long(n);
+#pragma omp parallel for schedule(static) if (ln >= 4096)
+    for (long li = 0; li < ln; ++li) {
+      const std::size_t i = std::size_t(li);
+      const double eps = VolumeMapping::interpolate(alphaG_, weights_[i]);
+      const Eigen::Vector3d slip = VolumeMapping::interpolate(u, weights_[i]) - p.v[i];
+      const double re = d * eps * slip.norm() / nu;
+      k_[i] = stokes * eps * model_->normalisedDrag(eps, re);  // K_i [kg/s]
+    }
+    std::vector<Eigen::Vector3d> kv(cells, Eigen::Vector3d::Zero());
+    for (std::size_t i = 0; i < n; ++i)  // serial scatter in index order: deterministic
+      for (int q = 0; q < weights_[i].count; ++q) {
+        const std::size_t c = std::size_t(weights_[i].cell[std::size_t(q)]);
+        const double wk = weights_[i].w[std::size_t(q)] * k_[i];
+        beta_[c] += wk;
+        kv[c] += wk * p.v[i];
+      }
+    for (std::size_t c = 0; c < cells; ++c)
+      if (mapping_->usable()[c]) {
+        const double inv = 1.0 / mapping_->openVolume(c);
+        beta_[c] *= inv;
+        kv[c] *= inv;
+      }
+    if (smoother_) {
+      smoother_->smooth(beta_);
+      smoother_->smooth(kv);
+    }
+    for (std::size_t c = 0; c < cells; ++c) uP_[c] = beta_[c] > 0 ? Eigen::Vector3d(kv[c] / beta_[c]) : Eigen::Vector3d::Zero();
+  }
+  gas_.setDragSource(beta_, uP_);
+}
+
+void FluidCoupling::applyForces() {
+  DemParticles& p = dem_.particles();
+  const std::size_t n = p.size();
+  if (weights_.size() != n) throw RunError("coupling: applyForces() without prepare() for the current parcels");
+  drag_.assign(n, Eigen::Vector3d::Zero());
+  const std::vector<Eigen::Vector3d> u = options_.drag ? gasVelocitySeen() : std::vector<Eigen::Vector3d>{};
+  const long ln = long(n);
+#pragma omp parallel for schedule(static) if (ln >= 4096)
+  for (long li = 0; li < ln; ++li) {
+    const std::size_t i = std::size_t(li);
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    if (options_.drag) {
+      drag_[i] = k_[i] * (VolumeMapping::interpolate(u, weights_[i]) - p.v[i]);
+      f += drag_[i];
+    }
+    if (options_.pressureForce) f -= parcelVolume(p, i) * gas_.pressureGradientAt(p.x[i]);
+    p.fluid_force[i] = f;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (!p.fluid_force[i].allFinite()) {
+      std::ostringstream s;
+      s << "coupling: the fluid force on parcel " << p.id[i] << " at (" << p.x[i].transpose() << ") m is not finite at t = "
+        << dem_.time() << " s";
+      throw RunError(s.str());
+    }
+}
+
+Eigen::Vector3d FluidCoupling::particleDragSum() const {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (const auto& f : drag_) s += f;
+  return s;
+}
+
+Eigen::Vector3d FluidCoupling::gasDragSum() const {
+  const std::vector<Eigen::Vector3d> u = gas_.cellVelocity();
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (std::size_t c = 0; c < beta_.size(); ++c)
+    if (beta_[c] > 0) s += mapping_->openVolume(c) * beta_[c] * (uP_[c] - u[c]);
+  return s;
+}
+
+void FluidCoupling::restoreFraction(std::vector<double> alphaP) {
+  if (alphaP.size() != alphaP_.size()) throw RunError("coupling checkpoint: alpha_P does not match the grid");
+  alphaP_ = std::move(alphaP);
+  for (std::size_t c = 0; c < alphaP_.size(); ++c) alphaG_[c] = mapping_->usable()[c] ? 1.0 - alphaP_[c] : 1.0;
+}
+
+double FluidCoupling::maxParticleFraction() const {
+  return alphaP_.empty() ? 0.0 : *std::max_element(alphaP_.begin(), alphaP_.end());
+}
+
+}  // namespace rcfd::coupling

@@ -1,0 +1,155 @@
+// Cloud-in-cell particle volume mapping on open cells and its over-packing treatment (VolumeMapping.hpp).
+
+#include "cfddem/coupling/VolumeMapping.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/Errors.hpp"
+
+namespace rcfd::coupling {
+
+VolumeMapping::VolumeMapping(const CartesianGrid& grid, std::vector<double> openFraction, std::vector<char> usable)
+    : grid_(grid), phi_(std::move(openFraction)), usable_(std::move(usable)) {
+  if (phi_.size() != std::size_t(grid_.cellCount()) || usable_.size() != phi_.size())
+    throw RunError("volume mapping: open fractions do not match the grid");
+  for (std::size_t c = 0; c < phi_.size(); ++c)
+    if (!(phi_[c] > 0)) usable_[c] = 0;
+}
+
+KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
+  KernelWeights out;
+  int i0[3];
+  double w1[3];
+  for (int a = 0; a < 3; ++a) {
+    // Cell centres sit at o + (i + 1/2) h; beyond the outermost centres the weight stays on them.
+    const int n = grid_.shape[std::size_t(a)];
+    const double t = std::clamp((x[a] - grid_.origin[a]) / grid_.spacing[a] - 0.5, 0.0, double(n - 1));
+    i0[a] = n == 1 ? 0 : std::min(int(std::floor(t)), n - 2);
+    w1[a] = n == 1 ? 0.0 : t - i0[a];
+  }
+  double sum = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const int o[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
+    double w = 1.0;
+    for (int a = 0; a < 3; ++a) w *= o[a] ? w1[a] : 1.0 - w1[a];
+    if (w == 0.0) continue;
+    const std::int64_t cell = grid_.flatIndex(i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]);
+    if (!usable_[std::size_t(cell)]) continue;
+    w *= phi_[std::size_t(cell)];  // a cut cell takes its open share only
+    out.cell[std::size_t(out.count)] = std::int32_t(cell);
+    out.w[std::size_t(out.count)] = w;
+    ++out.count;
+    sum += w;
+  }
+  if (out.count > 0) {
+    const double inv = 1.0 / sum;
+    double total = 0.0;
+    for (int k = 0; k < out.count; ++k) total += (out.w[std::size_t(k)] *= inv);
+    out.w[0] += 1.0 - total;  // the weights sum to one to the last bit: volume is conserved exactly
+    return out;
+  }
+  // All eight centres closed (a parcel in a narrow gap between walls): its nearest usable cell.
+  const auto own = grid_.cellOf(x);
+  double best = 1e300;
+  for (int dk = -1; dk <= 1; ++dk)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const int i = own[0] + di, j = own[1] + dj, k = own[2] + dk;
+        if (i < 0 || j < 0 || k < 0 || i >= grid_.shape[0] || j >= grid_.shape[1] || k >= grid_.shape[2]) continue;
+        const std::int64_t cell = grid_.flatIndex(i, j, k);
+        if (!usable_[std::size_t(cell)]) continue;
+        const double d2 = (grid_.cellCenter(i, j, k) - x).squaredNorm();
+        if (d2 < best) best = d2, out.cell[0] = std::int32_t(cell);
+      }
+  if (best == 1e300) {
+    std::ostringstream s;
+    s << "volume mapping: no open gas cell near the parcel at (" << x.x() << ", " << x.y() << ", " << x.z()
+      << ") m";
+    throw RunError(s.str());
+  }
+  out.w[0] = 1.0;
+  out.count = 1;
+  return out;
+}
+
+void VolumeMapping::weightsOf(const DemParticles& p, std::vector<KernelWeights>& out) const {
+  out.resize(p.size());
+  const long n = long(p.size());
+#pragma omp parallel for schedule(static) if (n >= 4096)
+  for (long i = 0; i < n; ++i) out[std::size_t(i)] = weights(p.x[std::size_t(i)]);
+}
+
+void VolumeMapping::scatterVolume(const DemParticles& p, const std::vector<KernelWeights>& w,
+                                  std::vector<double>& volume) const {
+  volume.assign(phi_.size(), 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double v = parcelVolume(p, i);
+    for (int k = 0; k < w[i].count; ++k) volume[std::size_t(w[i].cell[std::size_t(k)])] += w[i].w[std::size_t(k)] * v;
+  }
+}
+
+std::vector<double> VolumeMapping::fractionOf(const std::vector<double>& volume) const {
+  std::vector<double> a(volume.size(), 0.0);
+  for (std::size_t c = 0; c < a.size(); ++c)
+    if (usable_[c]) a[c] = volume[c] / openVolume(c);
+  return a;
+}
+
+long VolumeMapping::redistributeExcess(std::vector<double>& volume, double maxFraction, int maxSweeps) const {
+  const auto n = grid_.shape;
+  std::vector<std::size_t> over;
+  std::vector<char> gave(volume.size(), 0);
+  std::vector<double> moved;
+  for (int sweep = 0; sweep < maxSweeps; ++sweep) {
+    over.clear();
+    for (std::size_t c = 0; c < volume.size(); ++c)
+      if (usable_[c] && volume[c] > maxFraction * openVolume(c)) over.push_back(c);
+    if (over.empty()) break;
+    // Jacobi sweep: every over-full cell hands its excess to its usable face neighbours in proportion
+    // to their open volume; a neighbour pushed above the limit passes it on in the next sweep.
+    moved.assign(volume.size(), 0.0);
+    for (std::size_t c : over) {
+      const double excess = volume[c] - maxFraction * openVolume(c);
+      const auto ijk = grid_.cellIjk(std::int64_t(c));
+      std::size_t nb[6];
+      int count = 0;
+      double capacity = 0.0;
+      for (int d = 0; d < 3; ++d)
+        for (int s = -1; s <= 1; s += 2) {
+          auto q = ijk;
+          q[std::size_t(d)] += s;
+          if (q[std::size_t(d)] < 0 || q[std::size_t(d)] >= n[std::size_t(d)]) continue;
+          const std::size_t m = std::size_t(grid_.flatIndex(q[0], q[1], q[2]));
+          if (!usable_[m]) continue;
+          nb[count++] = m;
+          capacity += openVolume(m);
+        }
+      if (count == 0) continue;  // an isolated cell keeps its volume (checked by the caller's alpha_G)
+      gave[c] = 1;
+      moved[c] -= excess;
+      for (int k = 0; k < count; ++k) moved[nb[k]] += excess * openVolume(nb[k]) / capacity;
+    }
+    for (std::size_t c = 0; c < volume.size(); ++c) volume[c] += moved[c];
+  }
+  return long(std::count(gave.begin(), gave.end(), char(1)));
+}
+
+std::vector<Eigen::Vector3d> VolumeMapping::meanVelocity(const DemParticles& p,
+                                                         const std::vector<KernelWeights>& w) const {
+  std::vector<Eigen::Vector3d> mom(phi_.size(), Eigen::Vector3d::Zero());
+  std::vector<double> vol(phi_.size(), 0.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double v = parcelVolume(p, i);
+    for (int k = 0; k < w[i].count; ++k) {
+      const std::size_t c = std::size_t(w[i].cell[std::size_t(k)]);
+      vol[c] += w[i].w[std::size_t(k)] * v;
+      mom[c] += (w[i].w[std::size_t(k)] * v) * p.v[i];
+    }
+  }
+  for (std::size_t c = 0; c < mom.size(); ++c) mom[c] = vol[c] > 0 ? Eigen::Vector3d(mom[c] / vol[c]) : Eigen::Vector3d::Zero();
+  return mom;
+}
+
+}  // namespace rcfd::coupling
