@@ -83,8 +83,9 @@ std::string alphaFigure(const Scene& scene, const FieldDatabase& db, const std::
     svg.text(bx + 1.15 * barW, y0 + h * a / kAlphaScale, fmt("%.1f", a), 9);
   }
   svg.textPx(10, 14,
-             "alpha_P on the mid-plane z = " + fmt("%.4g", (g.origin.z() + (k + 0.5) * g.spacing.z())) +
-                 " m (cell layer " + std::to_string(k) + "), " + std::to_string(db.frameCount()) +
+             "alpha_P in the cell layer " + std::to_string(k) + " holding the mid-plane (z = " +
+                 fmt("%.4g", g.origin.z() + k * g.spacing.z()) + " .. " +
+                 fmt("%.4g", g.origin.z() + (k + 1) * g.spacing.z()) + " m), " + std::to_string(db.frameCount()) +
                  " frames at dt_rec = " + fmt("%.4g", db.dtRec()) + " s",
              12);
   const std::string name = "database_alpha_p.svg";

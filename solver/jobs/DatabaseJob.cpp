@@ -105,12 +105,19 @@ class DatabaseJob final : public JobRunner {
       const double done = scene.dem.settle_time + double(sim.demStep() - st.settledStep) * plan.dtDem;
       return total > 0.0 ? std::min(1.0, done / total) : 1.0;
     };
-    ProgressReporter progress(options.progressJson, options.progressInterval);
-    progress.setPriorWallTime(st.wallTime);
-    progress.setStartFraction(fraction());
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count(); };
+    // The ETA is this process's rate over the phase it is in: a fresh reporter after the filling, whose
+    // length does not tell how fast the coupled run goes.
+    std::unique_ptr<ProgressReporter> progress;
+    auto startProgress = [&] {
+      progress = std::make_unique<ProgressReporter>(options.progressJson, options.progressInterval);
+      progress->setPriorWallTime(st.wallTime + elapsed());
+      progress->setStartFraction(fraction());
+    };
+    startProgress();
     auto save = [&] {
       JobState now = st;
-      now.wallTime = st.wallTime + progress.wallTime();
+      now.wallTime = st.wallTime + elapsed();
       saveCheckpoint(checkpoint, job, sim, now, rec.get());
     };
     auto cancelled = [&](const std::string& where) {
@@ -119,12 +126,14 @@ class DatabaseJob final : public JobRunner {
     };
 
     if (!st.settled) {
+      progress->report(0.0, sim.time(), true);
       st.fill = sim.fillAndSettle();
       st.settled = true;
       st.settledStep = sim.demStep();
       makeRecorder();
       writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(), scene.source_json);
-      progress.report(fraction(), sim.time(), true);
+      progress->report(fraction(), sim.time(), true);
+      startProgress();
       if (cancellationRequested() || options.stopAfterSteps == 0) cancelled("after settling");
     } else {
       writer = FieldDatabaseWriter::reopen(databasePath, sim.grid(), int(st.framesWritten));
@@ -161,7 +170,7 @@ class DatabaseJob final : public JobRunner {
         save();
         lastCheckpoint = sim.demStep();
       }
-      progress.report(fraction(), sim.time());
+      progress->report(fraction(), sim.time());
     }
     writer->close();
     {
@@ -169,9 +178,9 @@ class DatabaseJob final : public JobRunner {
       rec->write(db);
       db.flush();
     }
-    progress.report(1.0, sim.time(), true);
+    progress->report(1.0, sim.time(), true);
 
-    const double wall = st.wallTime + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    const double wall = st.wallTime + elapsed();
     const std::size_t parcels = sim.dem().particles().size();
     nlohmann::json summary = {{"kind", job.kind},
                               {"status", "succeeded"},

@@ -181,6 +181,16 @@ TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
   for (std::size_t i = 1; i < probes.size(); i += 2) EXPECT_EQ(probes[i], 0.0);
   EXPECT_GT(s["probes"][0]["alpha_p_mean"].get<double>(), 0.2);   // in the settled bed
   EXPECT_EQ(s["probes"][1]["alpha_p_mean"].get<double>(), 0.0);  // above it
+
+  // rcfd-solve database-figures draws the same figures from the file and reports the same probes.
+  const SolveResult figures =
+      solve("database-figures " + (dir_ / "a" / "database.h5").string() + " --out " + (dir_ / "figs").string());
+  ASSERT_EQ(figures.exitCode, 0) << figures.out;
+  const json fj = json::parse(figures.out);
+  EXPECT_EQ(fj["frames"].get<int>(), 10);
+  EXPECT_EQ(fj["probes"], s["probes"]);
+  EXPECT_EQ(fj["pressure_drop"]["samples"].get<int>(), 80);
+  EXPECT_TRUE(fs::exists(dir_ / "figs" / "database_alpha_p.svg"));
 }
 
 TEST_F(DatabaseJob, StoppedAndResumedEqualsUninterrupted) {
