@@ -43,6 +43,14 @@ void FluidCoupling::prepare() {
   const std::size_t n = p.size(), cells = alphaP_.size();
   mapping_->weightsOf(p, weights_);
   mapping_->scatterVolume(p, weights_, volume_);
+  // The drag closure sees the parcel's own surroundings: the mapped (unsmoothed) packing, with the
+  // over-packing redistribution. Smoothing is a device for the gas equations (Eq. 3, "to ensure
+  // stability"); a smoothed packing in F(eps, Re), which is convex in alpha_P, would take drag away
+  // from every parcel near the edge of a dense region (docs/physics.md).
+  localVolume_ = volume_;
+  mapping_->redistributeExcess(localVolume_, options_.maxParticleFraction);
+  localAlphaG_ = mapping_->fractionOf(localVolume_);
+  for (std::size_t c = 0; c < cells; ++c) localAlphaG_[c] = 1.0 - localAlphaG_[c];
   if (smoother_) {
     for (std::size_t c = 0; c < cells; ++c)
       alphaP_[c] = mapping_->usable()[c] ? volume_[c] / mapping_->openVolume(c) : 0.0;
@@ -62,7 +70,9 @@ void FluidCoupling::prepare() {
       throw RunError(s.str());
     }
   }
-  gas_.setGasFraction(alphaG_);
+  if (first_) gas_.setGasFraction(alphaG_, std::vector<double>(cells, 0.0));
+  else gas_.setGasFraction(alphaG_);
+  first_ = false;
 
   k_.assign(n, 0.0);
   std::fill(beta_.begin(), beta_.end(), 0.0);
@@ -76,7 +86,7 @@ void FluidCoupling::prepare() {
 #pragma omp parallel for schedule(static) if (ln >= 4096)
     for (long li = 0; li < ln; ++li) {
       const std::size_t i = std::size_t(li);
-      const double eps = VolumeMapping::interpolate(alphaG_, weights_[i]);
+      const double eps = VolumeMapping::interpolate(localAlphaG_, weights_[i]);
       const Eigen::Vector3d slip = VolumeMapping::interpolate(u, weights_[i]) - p.v[i];
       const double re = d * eps * slip.norm() / nu;
       k_[i] = stokes * eps * model_->normalisedDrag(eps, re);  // K_i [kg/s]
@@ -148,6 +158,7 @@ Eigen::Vector3d FluidCoupling::gasDragSum() const {
 void FluidCoupling::restoreFraction(std::vector<double> alphaP) {
   if (alphaP.size() != alphaP_.size()) throw RunError("coupling checkpoint: alpha_P does not match the grid");
   alphaP_ = std::move(alphaP);
+  first_ = false;  // the gas state of the checkpoint has this alpha_G already
   for (std::size_t c = 0; c < alphaP_.size(); ++c) alphaG_[c] = mapping_->usable()[c] ? 1.0 - alphaP_[c] : 1.0;
 }
 

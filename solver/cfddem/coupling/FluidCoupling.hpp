@@ -74,8 +74,12 @@ class FluidCoupling {
   std::unique_ptr<FieldSmoother> smoother_;
   std::vector<KernelWeights> weights_;
   std::vector<double> volume_, alphaP_, alphaG_, beta_, k_;
+  std::vector<double> localVolume_, localAlphaG_;  ///< unsmoothed packing for the drag closure
   std::vector<Eigen::Vector3d> uP_, drag_;
   long redistributed_ = 0;
+  /// The first prepare() finds the gas at alpha_G = 1 although the bed was there all along (settled
+  /// with the gas off): it sets alpha_G without a rate, so no spurious expulsion flow.
+  bool first_ = true;
 };
 
 }  // namespace rcfd::coupling

@@ -10,6 +10,9 @@
 
 namespace rcfd::coupling {
 
+/// A cell counts as over-packed above maxFraction (1 + this): the Jacobi sweeps converge geometrically.
+constexpr double kRedistributionTolerance = 1e-9;
+
 VolumeMapping::VolumeMapping(const CartesianGrid& grid, std::vector<double> openFraction, std::vector<char> usable)
     : grid_(grid), phi_(std::move(openFraction)), usable_(std::move(usable)) {
   if (phi_.size() != std::size_t(grid_.cellCount()) || usable_.size() != phi_.size())
@@ -105,7 +108,7 @@ long VolumeMapping::redistributeExcess(std::vector<double>& volume, double maxFr
   for (int sweep = 0; sweep < maxSweeps; ++sweep) {
     over.clear();
     for (std::size_t c = 0; c < volume.size(); ++c)
-      if (usable_[c] && volume[c] > maxFraction * openVolume(c)) over.push_back(c);
+      if (usable_[c] && volume[c] > maxFraction * openVolume(c) * (1.0 + kRedistributionTolerance)) over.push_back(c);
     if (over.empty()) break;
     // Jacobi sweep: every over-full cell hands its excess to its usable face neighbours in proportion
     // to their open volume; a neighbour pushed above the limit passes it on in the next sweep.

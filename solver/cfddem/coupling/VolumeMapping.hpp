@@ -51,9 +51,9 @@ class VolumeMapping {
 
   /// Moves particle volume out of cells above maxFraction of their open volume into their usable face
   /// neighbours (in proportion to the neighbours' open volume), repeated until no cell is above the
-  /// limit or maxSweeps; exactly conservative. Returns the number of cells that gave volume.
+  /// limit (to a relative 1e-9) or maxSweeps; exactly conservative. Returns the number of cells that gave volume.
   long redistributeExcess(std::vector<double>& volume, double maxFraction = kMaxParticleFraction,
-                          int maxSweeps = 100) const;
+                          int maxSweeps = 1000) const;
 
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> meanVelocity(const DemParticles& p, const std::vector<KernelWeights>& w) const;

@@ -1,0 +1,132 @@
+// rcfd-bench cfddem: the coupled CFD-DEM of examples/quick.json (embedded) as the database job runs it.
+// The bed is filled and settled once (DEM only) and cached as a checkpoint in $TMPDIR; the gas is then
+// ramped up over `ramp` s (untimed) and the timed part runs `seconds` of coupled simulation. Reports
+// wall (and CPU) seconds per simulated second, parcel-steps per second including the gas, the share of
+// the gas, the mean DEM sub-steps per gas step and the largest alpha_P.
+//   --quick: ramp 0.02 s, 0.02 s timed.   Full: ramp 0.1 s, 0.2 s timed.
+//   RCFD_BENCH_CFDDEM_SECONDS=T: time T s instead; RCFD_BENCH_CFDDEM_RAMP=R: ramp R s;
+//   RCFD_BENCH_CFDDEM_SCENE=path: another scene file;
+//   RCFD_BENCH_CFDDEM_PGM=prefix: also writes alpha_P (mean over z) as prefix-alpha.pgm at the end.
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "BenchRegistry.hpp"
+#include "cfddem/CfdDemSimulation.hpp"
+#include "cfddem/gas/GasSolver.hpp"
+#include "core/EmbeddedFiles.hpp"
+#include "core/Hdf5.hpp"
+#include "scene/SceneLoader.hpp"
+
+namespace rcfd::bench {
+namespace {
+
+double envOr(const char* name, double fallback) {
+  const char* v = std::getenv(name);
+  return v ? std::atof(v) : fallback;
+}
+
+double cpuSeconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
+
+/// alpha_P averaged over z as an 8-bit image, black 0, white 0.65, y up.
+void writeAlphaImage(const CfdDemSimulation& sim, const std::string& path) {
+  const auto a = sim.particleFraction();
+  const auto& g = sim.grid();
+  std::ofstream out(path, std::ios::binary);
+  out << "P5\n" << g.shape[0] << " " << g.shape[1] << "\n255\n";
+  for (int j = g.shape[1] - 1; j >= 0; --j)
+    for (int i = 0; i < g.shape[0]; ++i) {
+      double s = 0.0;
+      for (int k = 0; k < g.shape[2]; ++k) s += a[std::size_t(g.flatIndex(i, j, k))];
+      out.put(char(std::lround(std::min(1.0, s / g.shape[2] / 0.65) * 255)));
+    }
+}
+
+nlohmann::json runCfdDem(const Options& o) {
+  const char* scenePath = std::getenv("RCFD_BENCH_CFDDEM_SCENE");
+  const Scene scene = scenePath ? loadSceneFile(scenePath)
+                                : loadSceneText(std::string(embeddedFiles().at("examples/quick.json")), "examples/quick.json");
+  const double ramp = envOr("RCFD_BENCH_CFDDEM_RAMP", o.quick ? 0.02 : 0.1);
+  const double seconds = envOr("RCFD_BENCH_CFDDEM_SECONDS", o.quick ? 0.02 : 0.2);
+  CfdDemSimulation sim(scene, 1);
+  const auto cache = std::filesystem::temp_directory_path() / ("rcfd-bench-cfddem-" + scene.name + "-settled.h5");
+  if (std::filesystem::exists(cache)) {
+    h5::File f(cache.string(), h5::File::Mode::ReadOnly);
+    sim.loadState(f, "/state");
+    std::cerr << "cfddem: settled bed from " << cache << "\n";
+  } else {
+    const auto t0 = std::chrono::steady_clock::now();
+    const FillResult r = sim.fillAndSettle();
+    std::cerr << "cfddem: filled " << r.inserted << " parcels in "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s wall\n";
+    h5::File f(cache.string(), h5::File::Mode::Create);
+    sim.saveState(f, "/state");
+  }
+  const std::size_t parcels = sim.dem().particles().size();
+  const std::int64_t stepsPerSecond = std::llround(1.0 / sim.demTimeStep());
+  // Ramp (untimed), as the database job does.
+  const std::int64_t rampEnd = sim.demStep() + std::llround(ramp * stepsPerSecond);
+  while (sim.demStep() < rampEnd) {
+    const double f = std::min(1.0, 1.0 - double(rampEnd - sim.demStep()) / (ramp * stepsPerSecond));
+    sim.setFlowFactor(std::max(0.0, f));
+    sim.step(rampEnd);
+  }
+  sim.setFlowFactor(1.0);
+  const std::int64_t start = sim.demStep(), end = start + std::llround(seconds * stepsPerSecond);
+  long couplingSteps = 0, pressureIterations = 0;
+  double gasWall = 0.0, maxAlphaP = 0.0, maxCourant = 0.0;
+  const double demWall0 = sim.dem().timings().drift + sim.dem().timings().build + sim.dem().timings().pairs +
+                          sim.dem().timings().gather;
+  const double cpu0 = cpuSeconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  while (sim.demStep() < end) {
+    sim.step(end);
+    ++couplingSteps;
+    pressureIterations += sim.lastStep().pressureIterations;
+    maxAlphaP = std::max(maxAlphaP, sim.lastStep().maxAlphaP);
+    maxCourant = std::max(maxCourant, sim.lastStep().courant);
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = cpuSeconds() - cpu0;
+  const double demWall = sim.dem().timings().drift + sim.dem().timings().build + sim.dem().timings().pairs +
+                         sim.dem().timings().gather - demWall0;
+  gasWall = wall - demWall;
+  const double simulated = double(end - start) * sim.demTimeStep();
+  const double parcelSteps = double(parcels) * double(end - start);
+  nlohmann::json out;
+  out["scene"] = scene.name;
+  out["parcels"] = parcels;
+  out["cells"] = sim.grid().cellCount();
+  out["simulated_s"] = simulated;
+  out["wall_s"] = wall;
+  out["cpu_s"] = cpu;
+  out["wall_s_per_simulated_s"] = wall / simulated;
+  out["cpu_s_per_simulated_s"] = cpu / simulated;
+  out["parcel_steps_per_s"] = parcelSteps / wall;
+  out["coupling_steps"] = couplingSteps;
+  out["mean_dem_steps_per_gas_step"] = double(end - start) / double(couplingSteps);
+  out["mean_pressure_iterations"] = double(pressureIterations) / double(couplingSteps);
+  out["dem_wall_share"] = demWall / wall;
+  out["gas_and_coupling_wall_share"] = gasWall / wall;
+  out["max_alpha_p"] = maxAlphaP;
+  out["max_courant"] = maxCourant;
+  out["pressure_drop_pa"] = sim.pressureDrop();
+  std::cerr << "cfddem " << scene.name << ": " << parcels << " parcels, " << simulated << " s simulated in " << wall
+            << " s wall (" << cpu << " s CPU): " << wall / simulated << " s wall per simulated s, "
+            << parcelSteps / wall << " parcel-steps/s, " << double(end - start) / double(couplingSteps)
+            << " DEM steps per gas step, DEM share " << demWall / wall << ", max alpha_P " << maxAlphaP
+            << ", pressure drop " << sim.pressureDrop() << " Pa\n";
+  if (const char* pgm = std::getenv("RCFD_BENCH_CFDDEM_PGM")) writeAlphaImage(sim, std::string(pgm) + "-alpha.pgm");
+  return out;
+}
+
+const bool registered = addBenchmark(
+    "cfddem", "coupled CFD-DEM of examples/quick.json: wall s per simulated s, parcel-steps/s including the gas",
+    runCfdDem);
+
+}  // namespace
+}  // namespace rcfd::bench

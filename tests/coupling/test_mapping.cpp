@@ -1,0 +1,128 @@
+// Particle volume mapping: exact conservation of the total volume, nothing in closed cells, alpha_P
+// of the open volume, the over-packing redistribution and Eq. (3) smoothing conservative.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "CouplingTestSupport.hpp"
+#include "cfddem/ApparatusWalls.hpp"
+
+namespace rcfd {
+namespace {
+
+using coupling::FieldSmoother;
+using coupling::KernelWeights;
+using coupling::VolumeMapping;
+
+struct SliceMapping {
+  Scene scene = test::quickSlice();
+  Apparatus apparatus{scene.apparatus};
+  CartesianGrid grid = makeGrid(apparatus, scene.grid);
+  gas::GasSolver gas{scene, apparatus, grid};
+  DemSystem dem{DemMaterial::fromScene(scene), wallsFromApparatus(apparatus), DemSystem::settingsFromScene(scene)};
+  VolumeMapping mapping{grid, gas.openFraction(), gas.activeCells()};
+};
+
+double totalParcelVolume(const DemParticles& p) {
+  double v = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) v += coupling::parcelVolume(p, i);
+  return v;
+}
+
+TEST(VolumeMapping, ConservesTheTotalParticleVolumeAndAvoidsClosedCells) {
+  SliceMapping m;
+  // Parcels everywhere in the chamber, many close to the V walls and the front/back walls (cut cells).
+  test::scatterParcels(m.dem, m.apparatus, 3000, m.dem.material().particle_radius, 7, 0.3);
+  std::vector<KernelWeights> w;
+  std::vector<double> volume;
+  m.mapping.weightsOf(m.dem.particles(), w);
+  m.mapping.scatterVolume(m.dem.particles(), w, volume);
+  double mapped = 0.0, inClosed = 0.0;
+  for (std::size_t c = 0; c < volume.size(); ++c) {
+    mapped += volume[c];
+    if (!m.gas.activeCells()[c]) inClosed += volume[c];
+  }
+  const double total = totalParcelVolume(m.dem.particles());
+  EXPECT_NEAR(mapped, total, 1e-13 * total);
+  EXPECT_EQ(inClosed, 0.0);
+  for (const auto& k : w) {
+    double s = 0.0;
+    for (int q = 0; q < k.count; ++q) {
+      s += k.w[std::size_t(q)];
+      EXPECT_GE(k.w[std::size_t(q)], 0.0);
+    }
+    EXPECT_NEAR(s, 1.0, 1e-15);
+  }
+  // alpha_P is of the open volume: summed back with V phi it gives the volume again.
+  const std::vector<double> a = m.mapping.fractionOf(volume);
+  double back = 0.0;
+  for (std::size_t c = 0; c < a.size(); ++c) back += a[c] * m.mapping.openVolume(c);
+  EXPECT_NEAR(back, total, 1e-13 * total);
+}
+
+TEST(VolumeMapping, SmoothInsideACellAndExactForAParcelOnACentre) {
+  SliceMapping m;
+  const Eigen::Vector3d c = m.grid.cellCenter(25, 20, 1);
+  const KernelWeights onCentre = m.mapping.weights(c);
+  ASSERT_EQ(onCentre.count, 1);
+  EXPECT_EQ(onCentre.cell[0], m.grid.flatIndex(25, 20, 1));
+  // Moving a parcel by a small distance moves a small part of its volume (no jumps at cell faces).
+  const Eigen::Vector3d h = m.grid.spacing;
+  const KernelWeights a = m.mapping.weights(c + Eigen::Vector3d(0.49 * h.x(), 0, 0));
+  const KernelWeights b = m.mapping.weights(c + Eigen::Vector3d(0.51 * h.x(), 0, 0));
+  ASSERT_EQ(a.count, 2);
+  ASSERT_EQ(b.count, 2);
+  EXPECT_NEAR(a.w[0], 0.51, 1e-12);
+  EXPECT_NEAR(b.w[0], 0.49, 1e-12);
+}
+
+TEST(VolumeMapping, OverPackedCellsGiveTheirExcessToNeighboursConservatively) {
+  SliceMapping m;
+  std::vector<double> volume(std::size_t(m.grid.cellCount()), 0.0);
+  // A whole column of cells next to the V wall filled to alpha_P = 0.95 of its open volume, and its
+  // neighbours at 0.6: the excess has to travel more than one cell.
+  double total = 0.0;
+  for (std::size_t c = 0; c < volume.size(); ++c) {
+    if (!m.mapping.usable()[c]) continue;
+    const auto ijk = m.grid.cellIjk(std::int64_t(c));
+    const double y = m.grid.cellCenter(ijk[0], ijk[1], ijk[2]).y();
+    if (y > 0.05) continue;
+    volume[c] = (m.mapping.openFraction()[c] < 1.0 ? 0.95 : 0.6) * m.mapping.openVolume(c);
+    total += volume[c];
+  }
+  const long gave = m.mapping.redistributeExcess(volume);
+  EXPECT_GT(gave, 10);
+  double after = 0.0, maxA = 0.0;
+  const auto a = m.mapping.fractionOf(volume);
+  for (std::size_t c = 0; c < volume.size(); ++c) after += volume[c], maxA = std::max(maxA, a[c]);
+  EXPECT_NEAR(after, total, 1e-13 * total);
+  EXPECT_LE(maxA, coupling::kMaxParticleFraction * (1 + 1e-8));
+}
+
+TEST(FieldSmoother, Equation3IsConservativeAndBounded) {
+  SliceMapping m;
+  test::scatterParcels(m.dem, m.apparatus, 2000, m.dem.material().particle_radius, 11, 0.12);
+  std::vector<KernelWeights> w;
+  std::vector<double> volume;
+  m.mapping.weightsOf(m.dem.particles(), w);
+  m.mapping.scatterVolume(m.dem.particles(), w, volume);
+  std::vector<double> a = m.mapping.fractionOf(volume);
+  const double maxBefore = *std::max_element(a.begin(), a.end());
+  FieldSmoother s(m.mapping, m.gas.faceKinds(0), m.gas.faceKinds(1), m.gas.faceKinds(2), m.scene.gas.smoothing_length);
+  EXPECT_GT(s.subSteps(), 1);
+  s.smooth(a);
+  double total = 0.0, maxAfter = 0.0, minAfter = 1.0;
+  for (std::size_t c = 0; c < a.size(); ++c) {
+    total += a[c] * m.mapping.openVolume(c);
+    maxAfter = std::max(maxAfter, a[c]);
+    if (m.mapping.usable()[c]) minAfter = std::min(minAfter, a[c]);
+  }
+  const double v = totalParcelVolume(m.dem.particles());
+  EXPECT_NEAR(total, v, 1e-13 * v);
+  EXPECT_LT(maxAfter, maxBefore);  // peaks come down
+  EXPECT_GE(minAfter, 0.0);        // no negative fractions
+}
+
+}  // namespace
+}  // namespace rcfd
