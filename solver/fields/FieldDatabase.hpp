@@ -101,7 +101,8 @@ class FieldDatabaseWriter {
 
   /// Reopens a database file written by this class to go on appending after its first `keepFrames`
   /// frames; frames after them are discarded (the datasets shrink, the frame count follows). What a
-  /// resumed job does with frames sampled after its last checkpoint. rcfd::InputError naming the file
+  /// resumed job does with frames sampled after its last checkpoint. A stored /recurrence/matrix is
+  /// removed (it belongs to the old frames). rcfd::InputError naming the file
   /// and dataset when the file is not a database of `grid` or holds fewer than keepFrames frames.
   static std::unique_ptr<FieldDatabaseWriter> reopen(const std::string& path, const CartesianGrid& grid,
                                                      int keepFrames);

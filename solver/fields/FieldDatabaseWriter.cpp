@@ -143,6 +143,11 @@ std::unique_ptr<FieldDatabaseWriter> FieldDatabaseWriter::reopen(const std::stri
   hdf5::checkStatus(H5Dset_extent(s.uP, kept), path + ": shrinking " + layout::uP);
   hdf5::checkStatus(H5Dset_extent(s.uG, kept), path + ": shrinking " + layout::uG);
   s.written = keepFrames;
+  // A recurrence matrix computed on the old frames no longer describes the database.
+  if (hdf5::linkExists(s.file, layout::recurrenceMatrix)) {
+    hdf5::checkStatus(H5Ldelete(s.file, layout::recurrenceMatrix, H5P_DEFAULT),
+                      path + ": removing the stale " + layout::recurrenceMatrix);
+  }
   hdf5::setInt64Attribute(s.frames, layout::frameCountAttribute, s.written);
   hdf5::checkStatus(H5Fflush(s.file, H5F_SCOPE_GLOBAL), path + ": flush");
   return w;
