@@ -6,7 +6,8 @@
 //   --quick: ramp 0.02 s, 0.02 s timed.   Full: ramp 0.1 s, 0.2 s timed.
 //   RCFD_BENCH_CFDDEM_SECONDS=T: time T s instead; RCFD_BENCH_CFDDEM_RAMP=R: ramp R s;
 //   RCFD_BENCH_CFDDEM_SCENE=path: another scene file;
-//   RCFD_BENCH_CFDDEM_PGM=prefix: also writes alpha_P (mean over z) as prefix-alpha.pgm at the end.
+//   RCFD_BENCH_CFDDEM_PGM=prefix: also writes alpha_P (mean over z) as prefix-N.pgm every 0.2 s and
+//   prefix-alpha.pgm at the end. A progress line every 0.05 s simulated goes to stderr.
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -83,8 +84,19 @@ nlohmann::json runCfdDem(const Options& o) {
                           sim.dem().timings().gather;
   const double cpu0 = cpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
+  const std::int64_t report = std::max<std::int64_t>(1, std::llround(0.05 * stepsPerSecond));
+  std::int64_t nextReport = start + report;
+  const char* pgm = std::getenv("RCFD_BENCH_CFDDEM_PGM");
   while (sim.demStep() < end) {
-    sim.step(end);
+    sim.step(std::min(end, nextReport));
+    if (sim.demStep() == nextReport) {
+      std::cerr << "  t = " << sim.time() << " s: wall " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+                << " s, k " << sim.lastStep().demSteps << ", Courant " << sim.lastStep().courant << ", max alpha_P "
+                << sim.lastStep().maxAlphaP << ", pressure drop " << sim.pressureDrop() << " Pa\n";
+      if (pgm && (nextReport - start) % (4 * report) == 0)
+        writeAlphaImage(sim, std::string(pgm) + "-" + std::to_string((nextReport - start) / report) + ".pgm");
+      nextReport += report;
+    }
     ++couplingSteps;
     pressureIterations += sim.lastStep().pressureIterations;
     maxAlphaP = std::max(maxAlphaP, sim.lastStep().maxAlphaP);
@@ -120,7 +132,7 @@ nlohmann::json runCfdDem(const Options& o) {
             << parcelSteps / wall << " parcel-steps/s, " << double(end - start) / double(couplingSteps)
             << " DEM steps per gas step, DEM share " << demWall / wall << ", max alpha_P " << maxAlphaP
             << ", pressure drop " << sim.pressureDrop() << " Pa\n";
-  if (const char* pgm = std::getenv("RCFD_BENCH_CFDDEM_PGM")) writeAlphaImage(sim, std::string(pgm) + "-alpha.pgm");
+  if (pgm) writeAlphaImage(sim, std::string(pgm) + "-alpha.pgm");
   return out;
 }
 

@@ -24,7 +24,10 @@ FieldSmoother::FieldSmoother(const VolumeMapping& mapping, const std::vector<cha
   const double dDtau = length_ * length_ / subSteps_;
   const std::vector<char>* open[3] = {&open0, &open1, &open2};
   const auto n = g.shape;
+  stride_ = {1, std::size_t(n[0]), std::size_t(n[0]) * std::size_t(n[1])};
   for (int d = 0; d < 3; ++d) {
+    first_[std::size_t(d)] = stride_[std::size_t(d)];
+    g_[std::size_t(d)].assign(cells, 0.0);
     const double area = g.cellVolume() / h[d];
     for (int k = 0; k < n[2]; ++k)
       for (int j = 0; j < n[1]; ++j)
@@ -42,7 +45,7 @@ FieldSmoother::FieldSmoother(const VolumeMapping& mapping, const std::vector<cha
           const std::size_t b = std::size_t(g.flatIndex(hi[0], hi[1], hi[2]));
           if (!mapping.usable()[a] || !mapping.usable()[b]) continue;
           const double phi = std::min(mapping.openFraction()[a], mapping.openFraction()[b]);
-          links_.push_back(Link{std::int32_t(a), std::int32_t(b), dDtau * phi * area / h[d]});
+          g_[std::size_t(d)][b] = dDtau * phi * area / h[d];
         }
   }
 }
@@ -50,19 +53,32 @@ FieldSmoother::FieldSmoother(const VolumeMapping& mapping, const std::vector<cha
 template <class T>
 void FieldSmoother::smoothImpl(std::vector<T>& gamma) const {
   if (subSteps_ == 0) return;
-  std::vector<T> change(gamma.size());
+  thread_local std::vector<T> change;
+  const std::size_t n = gamma.size();
+  change.resize(n);
+  T* gm = gamma.data();
+  T* ch = change.data();
   for (int s = 0; s < subSteps_; ++s) {
     std::fill(change.begin(), change.end(), T(gamma[0] * 0.0));
-    for (const Link& l : links_) {
-      const T flux = l.g * (gamma[std::size_t(l.b)] - gamma[std::size_t(l.a)]);  // [m3] x gamma, into a
-      change[std::size_t(l.a)] += flux;
-      change[std::size_t(l.b)] -= flux;
+    for (int d = 0; d < 3; ++d) {
+      // Face between c - stride and c: the flux into the low cell is what the high cell loses. The
+      // faces of one axis never share a cell twice at the same offset, so the two updates are a
+      // gather and a scatter of the same array in a fixed order (deterministic).
+      const double* gd = g_[std::size_t(d)].data();
+      const std::size_t st = stride_[std::size_t(d)];
+      for (std::size_t c = first_[std::size_t(d)]; c < n; ++c) {
+        if (gd[c] == 0.0) continue;
+        const T flux = gd[c] * (gm[c] - gm[c - st]);
+        ch[c - st] += flux;
+        ch[c] -= flux;
+      }
     }
-    for (std::size_t c = 0; c < gamma.size(); ++c) gamma[c] += invVolume_[c] * change[c];
+    for (std::size_t c = 0; c < n; ++c) gm[c] += invVolume_[c] * ch[c];
   }
 }
 
 void FieldSmoother::smooth(std::vector<double>& gamma) const { smoothImpl(gamma); }
 void FieldSmoother::smooth(std::vector<Eigen::Vector3d>& gamma) const { smoothImpl(gamma); }
+void FieldSmoother::smooth(std::vector<Eigen::Vector4d>& gamma) const { smoothImpl(gamma); }
 
 }  // namespace rcfd::coupling

@@ -10,6 +10,7 @@
 /// keeps the momentum exchange exact when the gas velocity the parcels see is smoothed the same way.
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "cfddem/coupling/VolumeMapping.hpp"
@@ -30,19 +31,20 @@ class FieldSmoother {
   /// Smooths a per-volume field (gamma per cell; its integral sum V phi gamma is conserved).
   void smooth(std::vector<double>& gamma) const;
   void smooth(std::vector<Eigen::Vector3d>& gamma) const;
+  void smooth(std::vector<Eigen::Vector4d>& gamma) const;
 
  private:
   template <class T>
   void smoothImpl(std::vector<T>& gamma) const;
 
-  struct Link {
-    std::int32_t a, b;  ///< cells
-    double g;           ///< D dtau * conductance [m3]
-  };
   const VolumeMapping& mapping_;
   double length_;
   int subSteps_ = 0;
-  std::vector<Link> links_;
+  /// Per axis d, per cell c: D dtau * conductance [m3] of the face between c - stride_d and c (0 when
+  /// closed or at the grid's low boundary). Structured sweeps: contiguous, vectorisable.
+  std::array<std::vector<double>, 3> g_;
+  std::array<std::size_t, 3> stride_{};
+  std::array<std::size_t, 3> first_{};  ///< first cell index with a face on the low side along d
   std::vector<double> invVolume_;  ///< 1 / (V phi), 0 for unusable cells
 };
 

@@ -78,7 +78,9 @@ void FluidCoupling::prepare() {
   std::fill(beta_.begin(), beta_.end(), 0.0);
   std::fill(uP_.begin(), uP_.end(), Eigen::Vector3d::Zero());
   if (options_.drag) {
-    const std::vector<Eigen::Vector3d> u = gasVelocitySeen();
+    // The gas has not changed since the last applyForces(): its (smoothed) velocity is reused.
+    if (!seenValid_) uSeen_ = gasVelocitySeen();
+    const std::vector<Eigen::Vector3d>& u = uSeen_;
     const double cg = scene_.dem.coarse_graining, d = scene_.particles.diameter;
     const double nu = scene_.gas.kinematic_viscosity, mu = scene_.gas.density * nu;
     const double stokes = cg * cg * cg * 3.0 * std::numbers::pi * mu * d;
@@ -91,27 +93,24 @@ void FluidCoupling::prepare() {
       const double re = d * eps * slip.norm() / nu;
       k_[i] = stokes * eps * model_->normalisedDrag(eps, re);  // K_i [kg/s]
     }
-    std::vector<Eigen::Vector3d> kv(cells, Eigen::Vector3d::Zero());
+    // (beta, beta u_P) per cell in one array: scattered, smoothed, split.
+    std::vector<Eigen::Vector4d> bk(cells, Eigen::Vector4d::Zero());
     for (std::size_t i = 0; i < n; ++i)  // serial scatter in index order: deterministic
       for (int q = 0; q < weights_[i].count; ++q) {
         const std::size_t c = std::size_t(weights_[i].cell[std::size_t(q)]);
         const double wk = weights_[i].w[std::size_t(q)] * k_[i];
-        beta_[c] += wk;
-        kv[c] += wk * p.v[i];
+        bk[c] += wk * Eigen::Vector4d(1.0, p.v[i].x(), p.v[i].y(), p.v[i].z());
       }
     for (std::size_t c = 0; c < cells; ++c)
-      if (mapping_->usable()[c]) {
-        const double inv = 1.0 / mapping_->openVolume(c);
-        beta_[c] *= inv;
-        kv[c] *= inv;
-      }
-    if (smoother_) {
-      smoother_->smooth(beta_);
-      smoother_->smooth(kv);
+      if (mapping_->usable()[c]) bk[c] /= mapping_->openVolume(c);
+    if (smoother_) smoother_->smooth(bk);
+    for (std::size_t c = 0; c < cells; ++c) {
+      beta_[c] = bk[c][0];
+      uP_[c] = beta_[c] > 0 ? Eigen::Vector3d(bk[c].tail<3>() / beta_[c]) : Eigen::Vector3d::Zero();
     }
-    for (std::size_t c = 0; c < cells; ++c) uP_[c] = beta_[c] > 0 ? Eigen::Vector3d(kv[c] / beta_[c]) : Eigen::Vector3d::Zero();
   }
   gas_.setDragSource(beta_, uP_);
+  seenValid_ = false;  // the gas steps next
 }
 
 void FluidCoupling::applyForces() {
@@ -119,7 +118,9 @@ void FluidCoupling::applyForces() {
   const std::size_t n = p.size();
   if (weights_.size() != n) throw RunError("coupling: applyForces() without prepare() for the current parcels");
   drag_.assign(n, Eigen::Vector3d::Zero());
-  const std::vector<Eigen::Vector3d> u = options_.drag ? gasVelocitySeen() : std::vector<Eigen::Vector3d>{};
+  if (options_.drag) uSeen_ = gasVelocitySeen();
+  seenValid_ = options_.drag;
+  const std::vector<Eigen::Vector3d>& u = uSeen_;
   const long ln = long(n);
 #pragma omp parallel for schedule(static) if (ln >= 4096)
   for (long li = 0; li < ln; ++li) {

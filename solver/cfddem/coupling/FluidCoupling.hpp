@@ -80,6 +80,10 @@ class FluidCoupling {
   /// The first prepare() finds the gas at alpha_G = 1 although the bed was there all along (settled
   /// with the gas off): it sets alpha_G without a rate, so no spurious expulsion flow.
   bool first_ = true;
+  /// Gas velocity at cell centres as the parcels see it (smoothed with smoothing), valid from
+  /// applyForces() until the gas steps again.
+  std::vector<Eigen::Vector3d> uSeen_;
+  bool seenValid_ = false;
 };
 
 }  // namespace rcfd::coupling
