@@ -61,19 +61,21 @@ std::string scheduleError(const json& scene) {
 TEST(DatabaseSchedule, WholeStepsOfTheQuickScene) {
   const rcfd::Scene s = rcfd::loadSceneFile(std::string(RCFD_SOURCE_DIR) + "/examples/quick.json");
   const auto p = rcfd::DatabaseSchedule::fromScene(s);
-  EXPECT_EQ(p.frameSteps, 500);   // 5 ms / 1e-5 s
-  EXPECT_EQ(p.sampleSteps, 100);  // 1 ms / 1e-5 s
-  EXPECT_EQ(p.frames, 400);       // 2 s at 200 Hz
+  // Read from the scene, so the expectations follow its time step.
+  const double dt = s.dem.time_step;
+  EXPECT_EQ(p.frameSteps, std::llround(0.005 / dt));
+  EXPECT_EQ(p.sampleSteps, std::llround(0.001 / dt));
+  EXPECT_EQ(p.frames, 400);  // 2 s at 200 Hz
   EXPECT_EQ(p.referenceSamples, 2000);
-  EXPECT_EQ(p.rampSteps, 20000);
-  EXPECT_EQ(p.warmupSteps, 100000);
+  EXPECT_EQ(p.rampSteps, std::llround(0.2 / dt));
+  EXPECT_EQ(p.warmupSteps, std::llround(1.0 / dt));
   EXPECT_EQ(p.sampledSamples(), 2000);
-  EXPECT_EQ(p.frameOffset(0), 120000);
-  EXPECT_EQ(p.endOffset(), 120000 + 3999 * 100);
+  EXPECT_EQ(p.frameOffset(0), p.rampSteps + p.warmupSteps);
+  EXPECT_EQ(p.endOffset(), p.frameOffset(0) + 3999 * p.sampleSteps);
   EXPECT_DOUBLE_EQ(p.flowFactor(0), 0.0);
-  EXPECT_DOUBLE_EQ(p.flowFactor(5000), 0.25);
-  EXPECT_DOUBLE_EQ(p.flowFactor(20000), 1.0);
-  EXPECT_DOUBLE_EQ(p.flowFactor(200000), 1.0);
+  EXPECT_DOUBLE_EQ(p.flowFactor(p.rampSteps / 4), 0.25);
+  EXPECT_DOUBLE_EQ(p.flowFactor(p.rampSteps), 1.0);
+  EXPECT_DOUBLE_EQ(p.flowFactor(10 * p.rampSteps), 1.0);
 }
 
 TEST(DatabaseSchedule, RefusesRatesThatMissDemStepsNamingTheField) {
