@@ -94,16 +94,28 @@ std::string alphaFigure(const Scene& scene, const FieldDatabase& db, const std::
   return name;
 }
 
+/// 1, 2 or 5 times a power of ten, close to `raw` (axis ticks on round numbers).
+double niceStep(double raw) {
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  const double f = raw / p;
+  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
+}
+
 std::string pressureFigure(const PressureDropSeries& p, const std::string& dir) {
-  const double t1 = p.t0 + double(p.pa.size()) * p.dt;
+  constexpr int kTicks = 6;
+  const double tEnd = p.t0 + double(p.pa.size()) * p.dt;
   double lo = *std::min_element(p.pa.begin(), p.pa.end()), hi = *std::max_element(p.pa.begin(), p.pa.end());
   if (hi - lo < 1e-9 * std::max(1.0, std::abs(hi))) {
     lo -= 1.0;
     hi += 1.0;
   }
-  const double pad = 0.08 * (hi - lo);
-  SvgDocument svg(p.t0, t1, lo - pad, hi + pad, 720, 320, 55);
-  svg.axes("time after the start of sampling [s]", "pressure drop [Pa]", 8, 5);
+  const double ys = niceStep((hi - lo) / kTicks), ts = niceStep((tEnd - p.t0) / kTicks);
+  lo = std::floor(lo / ys) * ys;
+  hi = std::ceil(hi / ys) * ys;
+  const double t0 = std::floor(p.t0 / ts) * ts, t1 = std::ceil(tEnd / ts) * ts;
+  SvgDocument svg(t0, t1, lo, hi, 720, 320, 55);
+  svg.axes("time after the start of sampling [s]", "pressure drop [Pa]", int(std::lround((t1 - t0) / ts)),
+           int(std::lround((hi - lo) / ys)));
   std::vector<std::array<double, 2>> pts;
   pts.reserve(p.pa.size());
   double mean = 0.0;
@@ -113,7 +125,7 @@ std::string pressureFigure(const PressureDropSeries& p, const std::string& dir) 
   }
   mean /= double(p.pa.size());
   svg.polyline(pts, "#1f4e99", 1.0);
-  svg.line(p.t0, mean, t1, mean, "#d62728", 1.0, "5,4");
+  svg.line(p.t0, mean, tEnd, mean, "#d62728", 1.0, "5,4");
   svg.textPx(60, 16,
              "Bed pressure drop (inlet - outlet); dashed: mean " + fmt("%.1f", mean) + " Pa; dominant frequency " +
                  (p.dominantFrequency ? fmt("%.2f", *p.dominantFrequency) + " Hz" : std::string("none")),
