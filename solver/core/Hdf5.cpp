@@ -155,6 +155,7 @@ std::string File::readString(const std::string& name) const {
   if (H5Tis_variable_str(type.id()) > 0) {
     Handle memType(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(memType.id(), H5T_VARIABLE);
+    H5Tset_cset(memType.id(), H5Tget_cset(type.id()));  // HDF5 does not convert ASCII <-> UTF-8
     char* ptr = nullptr;
     check(H5Dread(set.id(), memType.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, &ptr), "read " + name);
     std::string out = ptr ? ptr : "";
@@ -165,6 +166,7 @@ std::string File::readString(const std::string& name) const {
   std::string out(size, '\0');
   Handle memType(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Tset_size(memType.id(), size);
+  H5Tset_cset(memType.id(), H5Tget_cset(type.id()));
   check(H5Dread(set.id(), memType.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), "read " + name);
   out.resize(out.find('\0') == std::string::npos ? size : out.find('\0'));
   return out;
@@ -224,6 +226,7 @@ std::string File::stringAttribute(const std::string& object, const std::string& 
   if (H5Tis_variable_str(type.id()) > 0) {
     Handle memType(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(memType.id(), H5T_VARIABLE);
+    H5Tset_cset(memType.id(), H5Tget_cset(type.id()));  // HDF5 does not convert ASCII <-> UTF-8
     char* ptr = nullptr;
     check(H5Aread(a.id(), memType.id(), &ptr), "read attribute " + attr);
     std::string out = ptr ? ptr : "";

@@ -99,6 +99,14 @@ class FieldDatabaseWriter {
   FieldDatabaseWriter(const FieldDatabaseWriter&) = delete;
   FieldDatabaseWriter& operator=(const FieldDatabaseWriter&) = delete;
 
+  /// Reopens a database file written by this class to go on appending after its first `keepFrames`
+  /// frames; frames after them are discarded (the datasets shrink, the frame count follows). What a
+  /// resumed job does with frames sampled after its last checkpoint. A stored /recurrence/matrix is
+  /// removed (it belongs to the old frames). rcfd::InputError naming the file
+  /// and dataset when the file is not a database of `grid` or holds fewer than keepFrames frames.
+  static std::unique_ptr<FieldDatabaseWriter> reopen(const std::string& path, const CartesianGrid& grid,
+                                                     int keepFrames);
+
   /// Appends frame framesWritten(); refuses wrongly sized or non-finite frames (rcfd::InputError
   /// naming the dataset). After it returns the frame is on disk (H5Fflush).
   void append(const FieldFrame& frame);
@@ -106,6 +114,7 @@ class FieldDatabaseWriter {
   void close();
 
  private:
+  FieldDatabaseWriter();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

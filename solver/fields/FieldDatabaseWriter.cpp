@@ -98,6 +98,61 @@ FieldDatabaseWriter::FieldDatabaseWriter(const std::string& path, const Cartesia
   hdf5::checkStatus(H5Fflush(s.file, H5F_SCOPE_GLOBAL), path + ": flush");
 }
 
+FieldDatabaseWriter::FieldDatabaseWriter() : impl_(std::make_unique<Impl>()) {}
+
+std::unique_ptr<FieldDatabaseWriter> FieldDatabaseWriter::reopen(const std::string& path, const CartesianGrid& grid,
+                                                                 int keepFrames) {
+  hdf5::silenceErrors();
+  std::unique_ptr<FieldDatabaseWriter> w(new FieldDatabaseWriter());
+  Impl& s = *w->impl_;
+  s.path = path;
+  s.grid = grid;
+  s.file = Handle(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+  if (!s.file.valid()) throw InputError(path, "", "cannot open the database for appending");
+  if (!hdf5::linkExists(s.file, layout::frames)) throw InputError(path, layout::frames, "missing");
+  s.frames = hdf5::check(H5Gopen2(s.file, layout::frames, H5P_DEFAULT), layout::frames);
+  std::int64_t complete = -1;
+  if (hdf5::attributeExists(s.frames, layout::frameCountAttribute)) {
+    const auto count = hdf5::readNumericAttribute(s.frames, layout::frameCountAttribute);
+    if (count && !count->empty()) complete = std::int64_t(count->front());
+  }
+  auto open = [&](const char* name, int components) {
+    if (!hdf5::linkExists(s.file, name)) throw InputError(path, name, "missing");
+    Handle access = hdf5::check(H5Pcreate(H5P_DATASET_ACCESS), name);
+    H5Pset_chunk_cache(access, 0, 0, 1.0);
+    Handle set = hdf5::check(H5Dopen2(s.file, name, access), path + ": opening " + name);
+    const auto dims = hdf5::datasetDims(set);
+    const std::size_t rank = components == 1 ? 4 : 5;
+    const bool shapeOk = dims.size() == rank && dims[1] == hsize_t(grid.shape[2]) &&
+                         dims[2] == hsize_t(grid.shape[1]) && dims[3] == hsize_t(grid.shape[0]) &&
+                         (rank == 4 || dims[4] == 3);
+    if (!shapeOk) throw InputError(path, name, "does not have the frame shape of the job's grid");
+    if (complete < 0 || std::int64_t(dims[0]) < complete) complete = std::int64_t(dims[0]);
+    return set;
+  };
+  s.alphaP = open(layout::alphaP, 1);
+  s.uP = open(layout::uP, 3);
+  s.uG = open(layout::uG, 3);
+  if (keepFrames < 0 || keepFrames > complete) {
+    throw InputError(path, layout::frames, "holds " + std::to_string(complete) + " complete frames; cannot keep " +
+                                               std::to_string(keepFrames));
+  }
+  const hsize_t kept[5] = {hsize_t(keepFrames), hsize_t(grid.shape[2]), hsize_t(grid.shape[1]),
+                           hsize_t(grid.shape[0]), 3};
+  hdf5::checkStatus(H5Dset_extent(s.alphaP, kept), path + ": shrinking " + layout::alphaP);
+  hdf5::checkStatus(H5Dset_extent(s.uP, kept), path + ": shrinking " + layout::uP);
+  hdf5::checkStatus(H5Dset_extent(s.uG, kept), path + ": shrinking " + layout::uG);
+  s.written = keepFrames;
+  // A recurrence matrix computed on the old frames no longer describes the database.
+  if (hdf5::linkExists(s.file, layout::recurrenceMatrix)) {
+    hdf5::checkStatus(H5Ldelete(s.file, layout::recurrenceMatrix, H5P_DEFAULT),
+                      path + ": removing the stale " + layout::recurrenceMatrix);
+  }
+  hdf5::setInt64Attribute(s.frames, layout::frameCountAttribute, s.written);
+  hdf5::checkStatus(H5Fflush(s.file, H5F_SCOPE_GLOBAL), path + ": flush");
+  return w;
+}
+
 FieldDatabaseWriter::~FieldDatabaseWriter() {
   try {
     close();

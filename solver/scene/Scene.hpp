@@ -107,8 +107,10 @@ struct DemSpec {
   ContactPair friction{0.5, 0.24};         ///< k_fr
   ContactPair rolling_friction{0.06, 0.05};///< k_rfr
   double settle_time = 0.5;                ///< DEM-only settling before the gas starts [s]
-  double warmup = 3.0;                     ///< gas-on time before sampling starts [s]
+  double ramp_time = 0.2;                  ///< linear ramp of the gas flows from 0 to 1 after settling [s]
+  double warmup = 3.0;                     ///< gas-on time at full flow before sampling starts [s]
   double sample_rate = 200.0;              ///< field sampling frequency, 1/dt_rec [Hz]
+  double probe_rate = 1000.0;              ///< reference series (probes, pressure drop, holdup) [Hz]
   double sample_duration = 10.0;           ///< sampled period [s]
   double reference_duration = 10.0;        ///< period after sampling for reference statistics [s]
 };

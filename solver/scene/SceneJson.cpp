@@ -111,8 +111,10 @@ Scene sceneFromJson(const json& document) {
   readPair(d, "friction", s.dem.friction);
   readPair(d, "rolling_friction", s.dem.rolling_friction);
   read(d, "settle_time", s.dem.settle_time);
+  read(d, "ramp_time", s.dem.ramp_time);
   read(d, "warmup", s.dem.warmup);
   read(d, "sample_rate", s.dem.sample_rate);
+  read(d, "probe_rate", s.dem.probe_rate);
   read(d, "sample_duration", s.dem.sample_duration);
   read(d, "reference_duration", s.dem.reference_duration);
 
@@ -191,7 +193,8 @@ json sceneToJson(const Scene& s) {
                 {"max_overlap_fraction", d.max_overlap_fraction}, {"coupling_interval", d.coupling_interval},
                 {"restitution", pair(d.restitution)}, {"friction", pair(d.friction)},
                 {"rolling_friction", pair(d.rolling_friction)}, {"settle_time", d.settle_time},
-                {"warmup", d.warmup}, {"sample_rate", d.sample_rate}, {"sample_duration", d.sample_duration},
+                {"ramp_time", d.ramp_time}, {"warmup", d.warmup}, {"sample_rate", d.sample_rate},
+                {"probe_rate", d.probe_rate}, {"sample_duration", d.sample_duration},
                 {"reference_duration", d.reference_duration}};
   const auto& r = s.rcfd;
   doc["rcfd"] = {{"dt", r.dt}, {"tracers", r.tracers}, {"d0", r.d0}, {"u_fluc_max", r.u_fluc_max},

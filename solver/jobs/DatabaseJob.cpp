@@ -1,0 +1,291 @@
+// The "database" job (issue 7): the built-in CFD-DEM of the scene sampled into a recurrence field
+// database. Phases, in whole DEM steps (cfddem/DatabaseSchedule.hpp): fill and settle (DEM only), a
+// linear ramp of the gas flows, a warm-up at full flow, frames of alpha_P, u_P and u_G every dt_rec for
+// sample_duration (appended to DIR/database.h5 as they come), then the reference period. Throughout
+// the sampled and reference periods the reference series (probe u_P,y, pressure drop; spray-zone holdup
+// and stays in the reference period) are recorded every 1/probe_rate (cfddem/ReferenceRecorder.hpp)
+// and written under /reference/ at the end. A scene without the effect `gas` runs the DEM only.
+//
+// Checkpoints (DIR/checkpoint.h5, every checkpoint_interval and on cancellation) hold the simulation
+// state and the job's counters; a resumed job cuts database.h5 back to the frames sampled before the
+// checkpoint and goes on from there, so it writes what an uninterrupted job writes.
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <spdlog/spdlog.h>
+
+#include "analysis/DatabaseFigures.hpp"
+#include "cfddem/CfdDemSimulation.hpp"
+#include "cfddem/DatabaseSchedule.hpp"
+#include "cfddem/ReferenceRecorder.hpp"
+#include "core/Errors.hpp"
+#include "core/Hdf5.hpp"
+#include "fields/FieldDatabase.hpp"
+#include "jobs/Cancellation.hpp"
+#include "jobs/JobRunner.hpp"
+#include "jobs/Progress.hpp"
+
+namespace rcfd {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Frame cache when the figures read the database back: a few frames of the largest grids.
+constexpr std::int64_t kFigureCacheBytes = 256LL << 20;
+
+/// The scene's effects that belong to the CFD-DEM stage (x-stage "cfd_dem" in the schema).
+std::vector<std::string> cfdDemEffects(const Scene& scene) {
+  const auto schema = nlohmann::json::parse(schemaText("scene"));
+  std::vector<std::string> out;
+  for (const auto& o : schema.at("properties").at("effects").at("items").at("oneOf")) {
+    const std::string name = o.at("const");
+    if (o.value("x-stage", "") == "cfd_dem" && scene.hasEffect(name)) out.push_back(name);
+  }
+  return out;
+}
+
+FieldFrame sampleFrame(const CfdDemSimulation& sim) {
+  FieldFrame f;
+  const auto alpha = sim.particleFraction();
+  const auto up = sim.particleVelocity();
+  const auto ug = sim.gasVelocity();
+  f.alpha_p.assign(alpha.begin(), alpha.end());
+  f.u_p.resize(3 * up.size());
+  f.u_g.resize(3 * ug.size());
+  for (std::size_t c = 0; c < up.size(); ++c)
+    for (int d = 0; d < 3; ++d) f.u_p[3 * c + std::size_t(d)] = float(up[c][d]);
+  for (std::size_t c = 0; c < ug.size(); ++c)
+    for (int d = 0; d < 3; ++d) f.u_g[3 * c + std::size_t(d)] = float(ug[c][d]);
+  return f;
+}
+
+/// The job's own counters, saved beside the simulation state.
+struct JobState {
+  bool settled = false;
+  std::int64_t settledStep = 0;   ///< DEM clock when settling ended (offset 0 of the schedule)
+  std::int64_t framesWritten = 0;
+  std::int64_t couplingSteps = 0;
+  double wallTime = 0.0;          ///< wall seconds of earlier processes
+  FillResult fill;
+};
+
+class DatabaseJob final : public JobRunner {
+ public:
+  nlohmann::json run(const JobSpec& job, const RunOptions& options) override {
+    const Scene& scene = job.scene;
+    const DatabaseSchedule plan = DatabaseSchedule::fromScene(scene);
+    const auto wallStart = std::chrono::steady_clock::now();
+    const std::string checkpoint = options.outDir + "/checkpoint.h5";
+    const std::string databasePath = options.outDir + "/database.h5";
+
+    CfdDemSimulation sim(scene, job.seed);
+    const std::vector<double> open = openFractions(sim.apparatus(), sim.grid());
+    const std::vector<float> fluid(open.begin(), open.end());
+
+    JobState st;
+    std::unique_ptr<ReferenceRecorder> rec;
+    std::unique_ptr<FieldDatabaseWriter> writer;
+    auto makeRecorder = [&] {
+      rec = std::make_unique<ReferenceRecorder>(scene, sim.grid(), sim.dem().particles().size(), plan.sampleDt(),
+                                                plan.sampledSamples());
+    };
+    if (fs::exists(checkpoint)) {
+      loadCheckpoint(checkpoint, job, sim, st);
+      if (st.settled) {
+        makeRecorder();
+        h5::File f(checkpoint, h5::File::Mode::ReadOnly);
+        rec->load(f, "/reference");
+      }
+      spdlog::info("resumed from {} at t = {:.4f} s, {} frames kept", checkpoint, sim.time(), st.framesWritten);
+    }
+
+    const double total = scene.dem.settle_time + double(plan.endOffset()) * plan.dtDem;
+    auto fraction = [&] {
+      if (!st.settled) return 0.0;
+      const double done = scene.dem.settle_time + double(sim.demStep() - st.settledStep) * plan.dtDem;
+      return total > 0.0 ? std::min(1.0, done / total) : 1.0;
+    };
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count(); };
+    // The ETA is this process's rate over the phase it is in: a fresh reporter after the filling, whose
+    // length does not tell how fast the coupled run goes.
+    std::unique_ptr<ProgressReporter> progress;
+    auto startProgress = [&] {
+      progress = std::make_unique<ProgressReporter>(options.progressJson, options.progressInterval);
+      progress->setPriorWallTime(st.wallTime + elapsed());
+      progress->setStartFraction(fraction());
+    };
+    startProgress();
+    auto save = [&] {
+      JobState now = st;
+      now.wallTime = st.wallTime + elapsed();
+      saveCheckpoint(checkpoint, job, sim, now, rec.get());
+    };
+    auto cancelled = [&](const std::string& where) {
+      save();
+      throw Cancelled("stopped " + where + " at t = " + std::to_string(sim.time()) + " s; checkpoint " + checkpoint);
+    };
+
+    if (!st.settled) {
+      progress->report(0.0, sim.time(), true);
+      st.fill = sim.fillAndSettle();
+      st.settled = true;
+      st.settledStep = sim.demStep();
+      makeRecorder();
+      writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(), scene.source_json);
+      progress->report(fraction(), sim.time(), true);
+      startProgress();
+      if (cancellationRequested() || options.stopAfterSteps == 0) cancelled("after settling");
+    } else {
+      writer = FieldDatabaseWriter::reopen(databasePath, sim.grid(), int(st.framesWritten));
+    }
+
+    const std::int64_t checkpointEvery = std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / plan.dtDem));
+    std::int64_t lastCheckpoint = sim.demStep();
+    const std::int64_t firstCouplingStep = st.couplingSteps;
+    const std::int64_t totalSamples = plan.totalSamples();
+    while (true) {
+      // Events at the current instant first: a checkpoint taken after a step resumes here.
+      const std::int64_t offset = sim.demStep() - st.settledStep;
+      if (st.framesWritten < plan.frames && offset == plan.frameOffset(st.framesWritten)) {
+        writer->append(sampleFrame(sim));
+        ++st.framesWritten;
+      }
+      if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {
+        rec->record(sim.particleVelocity(), sim.pressureDrop(), sim.dem().particles());
+      }
+      if (st.framesWritten >= plan.frames && rec->samples() >= totalSamples) break;
+      std::int64_t next = plan.sampleOffset(rec->samples());
+      if (st.framesWritten < plan.frames) next = std::min(next, plan.frameOffset(st.framesWritten));
+      if (offset > next) {
+        throw RunError("database job: the clock passed a sampling instant (DEM step " +
+                       std::to_string(st.settledStep + next) + ")");
+      }
+      if (sim.hasGas()) sim.setFlowFactor(plan.flowFactor(offset));
+      sim.step(st.settledStep + next);
+      ++st.couplingSteps;
+      const bool stopForTest =
+          options.stopAfterSteps >= 0 && st.couplingSteps - firstCouplingStep >= options.stopAfterSteps;
+      if (cancellationRequested() || stopForTest) cancelled("at coupling step " + std::to_string(st.couplingSteps));
+      if (sim.demStep() - lastCheckpoint >= checkpointEvery) {
+        save();
+        lastCheckpoint = sim.demStep();
+      }
+      progress->report(fraction(), sim.time());
+    }
+    writer->close();
+    {
+      h5::File db(databasePath, h5::File::Mode::ReadWrite);
+      rec->write(db);
+      db.flush();
+    }
+    progress->report(1.0, sim.time(), true);
+
+    const double wall = st.wallTime + elapsed();
+    const std::size_t parcels = sim.dem().particles().size();
+    nlohmann::json summary = {{"kind", job.kind},
+                              {"status", "succeeded"},
+                              {"seed", job.seed},
+                              {"steps", sim.demStep()},
+                              {"coupling_steps", st.couplingSteps},
+                              {"sim_time_s", sim.time()},
+                              {"effects", cfdDemEffects(scene)},
+                              {"gas", sim.hasGas()},
+                              {"frames", st.framesWritten},
+                              {"dt_rec", plan.dtRec()},
+                              {"dt_dem", plan.dtDem},
+                              {"particles", parcels},
+                              {"particles_per_parcel", rec->particlesPerParcel()},
+                              {"database", "database.h5"}};
+    summary["phases"] = {{"fill_s", st.fill.fill_time},
+                         {"settle_s", st.fill.settle_time},
+                         {"settled", st.fill.settled},
+                         {"ramp_s", double(plan.rampSteps) * plan.dtDem},
+                         {"warmup_s", double(plan.warmupSteps) * plan.dtDem},
+                         {"sample_s", double(plan.frames) * plan.dtRec()},
+                         {"reference_s", double(plan.referenceSamples) * plan.sampleDt()},
+                         {"sampling_start_s", double(st.settledStep + plan.frameOffset(0)) * plan.dtDem}};
+    summary.update(rec->summary(plan.dtRec(), scene.outputs.residence_time_bins));
+    writeResultAndFigures(scene, databasePath, options.outDir, *rec, summary);
+    // Wall time and rates describe this machine, not the physics: the only keys allowed to differ
+    // between otherwise bit-identical runs.
+    summary["wall_time_s"] = wall;
+    summary["parcel_steps_per_s"] = wall > 0.0 ? double(parcels) * double(sim.demStep()) / wall : 0.0;
+    fs::remove(checkpoint);
+    return summary;
+  }
+
+ private:
+  static void saveCheckpoint(const std::string& path, const JobSpec& job, const CfdDemSimulation& sim,
+                             const JobState& st, const ReferenceRecorder* rec) {
+    const std::string tmp = path + ".tmp";
+    {
+      h5::File f(tmp, h5::File::Mode::Create);
+      f.writeString("/job/scene", job.scene.source_json);
+      f.write("/job/seed", std::vector<std::int64_t>{std::int64_t(job.seed)});
+      f.write("/job/counters", std::vector<std::int64_t>{st.settled, st.settledStep, st.framesWritten,
+                                                         st.couplingSteps, st.fill.inserted, st.fill.batches,
+                                                         st.fill.settled});
+      f.write("/job/times", std::vector<double>{st.wallTime, st.fill.fill_time, st.fill.settle_time,
+                                                st.fill.kinetic_energy});
+      sim.saveState(f, "/simulation");
+      if (rec) rec->save(f, "/reference");
+      f.flush();
+    }
+    fs::rename(tmp, path);
+  }
+
+  static void loadCheckpoint(const std::string& path, const JobSpec& job, CfdDemSimulation& sim, JobState& st) {
+    h5::File f(path, h5::File::Mode::ReadOnly);
+    if (f.readString("/job/scene") != job.scene.source_json ||
+        f.readInt64s("/job/seed").at(0) != std::int64_t(job.seed)) {
+      throw InputError(path, "/job", "the checkpoint belongs to another scene or seed; use a new output directory");
+    }
+    const auto c = f.readInt64s("/job/counters");
+    const auto t = f.readDoubles("/job/times");
+    st.settled = c.at(0) != 0;
+    st.settledStep = c.at(1);
+    st.framesWritten = c.at(2);
+    st.couplingSteps = c.at(3);
+    st.fill.inserted = long(c.at(4));
+    st.fill.batches = int(c.at(5));
+    st.fill.settled = c.at(6) != 0;
+    st.wallTime = t.at(0);
+    st.fill.fill_time = t.at(1);
+    st.fill.settle_time = t.at(2);
+    st.fill.kinetic_energy = t.at(3);
+    sim.loadState(f, "/simulation");
+  }
+
+  static void writeResultAndFigures(const Scene& scene, const std::string& databasePath, const std::string& outDir,
+                                    const ReferenceRecorder& rec, nlohmann::json& summary) {
+    auto db = FieldDatabase::open(databasePath, FrameStorage{kFigureCacheBytes});
+    const std::vector<double> mean = analysis::meanAlphaP(*db);
+    nlohmann::json probes = nlohmann::json::array();
+    for (const auto& p : scene.probes) {
+      probes.push_back({{"name", p.name}, {"alpha_p_mean", mean[std::size_t(db->grid().flatIndexOf(p.position))]}});
+    }
+    summary["probes"] = probes;
+    {
+      const std::string tmp = outDir + "/result.h5.tmp";
+      h5::File out(tmp, h5::File::Mode::Create);
+      out.writeString("/scene", scene.source_json);
+      const CartesianGrid& g = db->grid();
+      out.write("/fields/alpha_p_mean", mean, {hsize_t(g.shape[2]), hsize_t(g.shape[1]), hsize_t(g.shape[0])});
+      out.setAttribute("/fields/alpha_p_mean", "frames", std::int64_t(db->frameCount()));
+      out.flush();
+    }
+    fs::rename(outDir + "/result.h5.tmp", outDir + "/result.h5");
+    if (scene.outputs.svg) {
+      analysis::PressureDropSeries dp{rec.pressureDrop(), rec.dt(), 0.0, std::nullopt};
+      const auto& f = summary["pressure_drop"]["dominant_frequency_hz"];
+      if (f.is_number()) dp.dominantFrequency = f.get<double>();
+      summary["figures"] = analysis::writeDatabaseFigures(scene, *db, dp, outDir);
+    }
+  }
+};
+
+const bool registered = JobRunnerRegistry::add("database", "CFD-DEM sampled into a field database",
+                                               [] { return std::make_unique<DatabaseJob>(); });
+
+}  // namespace
+}  // namespace rcfd

@@ -1,0 +1,81 @@
+// FieldDatabaseWriter::reopen: what a resumed database job does with frames sampled after its last
+// checkpoint (cut back, then appended again), and the files it refuses.
+#include <gtest/gtest.h>
+
+#include "FieldTestUtil.hpp"
+#include "fields/Hdf5.hpp"
+
+using namespace rcfd;
+using namespace rcfd::test;
+
+TEST(FieldDatabaseReopen, CutsBackToTheKeptFramesAndAppendsAfterThem) {
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  const std::string path = writeWavyDatabase("reopen.h5", g, 6);
+  {
+    hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    hdf5::Handle g(H5Gcreate2(f, "/recurrence", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    hdf5::writeStringDataset(f, "/recurrence/matrix", "stale");  // any object there: reopen removes it
+  }
+  {
+    auto w = FieldDatabaseWriter::reopen(path, g, 4);
+    EXPECT_EQ(w->framesWritten(), 4);
+    FieldFrame f = makeFrame(g);
+    wavyFrame(g, 40, f);  // different content from the discarded frames 4 and 5
+    w->append(f);
+    w->close();
+  }
+  auto db = FieldDatabase::open(path);
+  ASSERT_EQ(db->frameCount(), 5);
+  for (int n = 0; n < 4; ++n) {
+    FieldFrame expected = makeFrame(g);
+    wavyFrame(g, n, expected);
+    EXPECT_EQ(db->frame(n)->alpha_p, expected.alpha_p) << n;
+    EXPECT_EQ(db->frame(n)->u_g, expected.u_g) << n;
+  }
+  FieldFrame appended = makeFrame(g);
+  wavyFrame(g, 40, appended);
+  EXPECT_EQ(db->frame(4)->alpha_p, appended.alpha_p);
+  EXPECT_EQ(db->frame(4)->u_p, appended.u_p);
+  EXPECT_EQ(db->fluidFraction(), variedFluid(g));
+  EXPECT_DOUBLE_EQ(db->dtRec(), 0.005);
+  hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  EXPECT_FALSE(hdf5::linkExists(f, "/recurrence/matrix"));
+}
+
+TEST(FieldDatabaseReopen, KeepingZeroFramesStartsOver) {
+  const CartesianGrid g = smallGrid(3, 2, 2);
+  const std::string path = writeWavyDatabase("reopen0.h5", g, 4);
+  {
+    auto w = FieldDatabaseWriter::reopen(path, g, 0);
+    for (int n = 10; n < 13; ++n) {
+      FieldFrame f = makeFrame(g);
+      wavyFrame(g, n, f);
+      w->append(f);
+    }
+  }
+  auto db = FieldDatabase::open(path);
+  ASSERT_EQ(db->frameCount(), 3);
+  FieldFrame expected = makeFrame(g);
+  wavyFrame(g, 10, expected);
+  EXPECT_EQ(db->frame(0)->alpha_p, expected.alpha_p);
+}
+
+TEST(FieldDatabaseReopen, RefusesMoreFramesThanStoredAndAnotherGrid) {
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  const std::string path = writeWavyDatabase("reopen-bad.h5", g, 3);
+  try {
+    FieldDatabaseWriter::reopen(path, g, 4);
+    FAIL() << "keeping 4 of 3 frames was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/frames"), std::string::npos) << e.what();
+  }
+  try {
+    FieldDatabaseWriter::reopen(path, smallGrid(5, 3, 2), 2);
+    FAIL() << "another grid was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/frames/alpha_p"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(FieldDatabaseWriter::reopen(tempPath("missing.h5"), g, 0), InputError);
+  // The refused attempts left the file as it was.
+  EXPECT_EQ(FieldDatabase::open(path)->frameCount(), 3);
+}
