@@ -100,6 +100,7 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
                 false);
   body_.emplace(std::move(*header_));
   body_->body_limit(router_.config().jsonBodyLimit);
+  if (body_->is_done()) return onBody({}, 0);  // no body (a GET): answer without another read
   http::async_read(stream_, buffer_, *body_,
                    beast::bind_front_handler(&HttpSession::onBody, shared_from_this()));
 }

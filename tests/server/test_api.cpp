@@ -227,10 +227,18 @@ TEST_F(Api, FiltersByStateAndKind) {
 
 TEST_F(Api, CancelQueuedJobAtOnceAndRecordsEvents) {
   const std::string id = server_->post("/v1/jobs", databaseJob().dump()).json().at("id");
+  // Polled twice while QUEUED (the second answer comes from the view cache) ...
+  EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "QUEUED");
+  EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "QUEUED");
   const auto r = server_->post("/v1/jobs/" + id + ":cancel", "");
   ASSERT_EQ(r.status, 200) << r.body;
   EXPECT_EQ(r.json().at("state"), "CANCELLED");
   EXPECT_FALSE(r.json().at("finished_at").is_null());
+  // ... and the next poll sees the change at once, in both views.
+  const auto polled = server_->get("/v1/jobs/" + id).json();
+  EXPECT_EQ(polled.at("state"), "CANCELLED");
+  EXPECT_EQ(polled, r.json());
+  EXPECT_EQ(server_->get("/v1/jobs/" + id + "?view=full").json().at("state"), "CANCELLED");
   // Cancelling a finished job is a conflict.
   expectProblem(server_->post("/v1/jobs/" + id + ":cancel", ""), 409);
   const auto events = server_->get("/v1/jobs/" + id + "/events").json().at("events");

@@ -1,5 +1,5 @@
 // End to end with the real solver: rcfd-server runs `rcfd-solve run` children. A field database is
-// written with rcfd::writeAnalyticDatabase (the real writer; the CFD-DEM database runner is not used
+// written with rcfd::writeAnalyticDatabase (SmallDatabase.hpp; the CFD-DEM database runner is not used
 // here), uploaded with the client, a spray job runs on it, and the coverage downloaded as CSV and as
 // HDF5 equals the histogram in the job's result.h5. Also: kill -9 of a solver fails only its job;
 // kill -9 of the server, restart, and the job resumes from its checkpoint to the same result.
@@ -11,51 +11,13 @@
 #include <sstream>
 
 #include "ServerFixture.hpp"
-#include "fields/AnalyticDatabase.hpp"
-#include "geometry/Apparatus.hpp"
-#include "scene/SceneLoader.hpp"
+#include "SmallDatabase.hpp"
 
 using namespace rcfd::test;
 
 namespace {
 
-constexpr int kFrames = 24;
 constexpr long kTracers = 200;
-
-/// examples/quick.json with fewer tracers, so a job takes a second or two.
-nlohmann::json smallScene(long tracers) {
-  auto scene = quickScene();
-  scene["rcfd"]["tracers"] = tracers;
-  return scene;
-}
-
-/// A database for the scene's grid: a spout swaying left and right (period 0.25 s) with an annulus
-/// sliding down, so tracers cross the spray zone and frames differ for the recurrence path.
-void writeDatabase(const nlohmann::json& sceneJson, const std::filesystem::path& path) {
-  const rcfd::Scene scene = rcfd::loadScene(sceneJson, "test scene");
-  const rcfd::Apparatus apparatus(scene.apparatus);
-  const auto grid = rcfd::makeGrid(apparatus, scene.grid);
-  const auto open = rcfd::openFractions(apparatus, grid);
-  const std::vector<float> fluid(open.begin(), open.end());
-  rcfd::writeAnalyticDatabase(
-      path.string(), grid, fluid, scene.rcfd.dt, kFrames,
-      [&](int, double t, rcfd::FieldFrame& f) {
-        const double centre = 0.01 * std::sin(2.0 * M_PI * t / 0.25);
-        for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
-          const auto ijk = grid.cellIjk(c);
-          const auto p = grid.cellCenter(ijk[0], ijk[1], ijk[2]);
-          const double dx = p.x() - centre;
-          const bool spout = std::abs(dx) < 0.015 && p.y() < 0.25;
-          const bool bed = p.y() < 0.12;
-          const auto i = std::size_t(c);
-          f.alpha_p[i] = float(spout ? 0.1 : (bed ? 0.5 : 0.01));
-          f.u_p[3 * i] = float(spout ? 0.2 * dx / 0.015 : (bed ? -0.1 * std::copysign(1.0, dx) : 0.0));
-          f.u_p[3 * i + 1] = float(spout ? 2.0 : (bed ? -0.15 : -1.0));
-          f.u_g[3 * i + 1] = float(spout ? 10.0 : 1.5);
-        }
-      },
-      sceneJson.dump());
-}
 
 std::vector<double> readDoubles(hid_t file, const char* name) {
   const hid_t set = H5Dopen2(file, name, H5P_DEFAULT);
@@ -184,8 +146,8 @@ class EndToEnd : public ::testing::Test {
     if (!std::filesystem::exists(binaryDir() / "rcfd-solve"))
       GTEST_SKIP() << "build rcfd-solve first";
     tmp_ = std::make_unique<TempDir>();
-    scene_ = smallScene(kTracers);
-    writeDatabase(scene_, tmp_->path() / "db.h5");
+    scene_ = withTracers(quickScene(), kTracers);
+    writeSmallDatabase(scene_, tmp_->path() / "db.h5");
   }
   std::unique_ptr<ServerProcess> start(int workers) {
     return std::make_unique<ServerProcess>(
