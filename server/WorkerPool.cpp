@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -206,6 +207,9 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
     std::vector<const char*> argv = {solver.c_str(), "run", jobFile.c_str(), "--out",
                                      outDir.c_str(), "--progress-json", nullptr};
     const pid_t parent = ::getpid();
+    // Solvers are batch work: nicer than the server, whose I/O threads answer polls in microseconds
+    // and would otherwise queue behind a solver's threads for a scheduler slice.
+    const int solverNice = std::min(19, ::getpriority(PRIO_PROCESS, 0) + config_.workerNice);
     // The child starts as a copy of the server, signal handlers included: Asio's SIGTERM handler
     // writes into the server's signal pipe, so a cancel (SIGTERM) reaching the child before exec
     // would shut the *server* down. So fork with every signal blocked, and let the child restore
@@ -228,6 +232,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       ::sigemptyset(&none);
       ::sigprocmask(SIG_SETMASK, &none, nullptr);  // a pending SIGTERM now ends the child: cancelled
       ::setpgid(0, 0);                      // a terminal's Ctrl-C reaches the server only
+      ::setpriority(PRIO_PROCESS, 0, solverNice);  // the solver's threads inherit it
       ::prctl(PR_SET_PDEATHSIG, SIGTERM);   // server gone -> checkpoint and exit 130
       if (::getppid() != parent) ::_exit(130);
       const int devnull = ::open("/dev/null", O_RDONLY);

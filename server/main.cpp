@@ -101,6 +101,9 @@ int main(int argc, char** argv) {
   app.add_option("--token-file", tokenFile, "file holding the bearer token (else RCFD_TOKEN, else DIR/token)");
   app.add_option("--workers", config.workers, "concurrent solver processes; 0 keeps jobs queued")->capture_default_str()
       ->check(CLI::Range(0, 1024));
+  app.add_option("--worker-nice", config.workerNice,
+                 "niceness added to solver processes, so HTTP answers do not wait behind them")
+      ->capture_default_str()->check(CLI::Range(0, 19));
   app.add_option("--solver", solver, "rcfd-solve executable (default: beside rcfd-server)");
   app.add_option("--io-threads", ioThreads, "threads serving HTTP")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-body-bytes", maxBody, "limit of a JSON request body")->capture_default_str();
