@@ -353,14 +353,67 @@ TEST_F(EndToEnd, CancelRunningJobCheckpointsAndEndsCancelled) {
   }
 }
 
-TEST_F(EndToEnd, InvalidUploadIs422NamingTheDataset) {
+/// Overwrites one value of a dataset of an HDF5 file (a damaged database for the upload tests).
+void poke(const std::filesystem::path& path, const char* dataset, hsize_t rank, double value) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t set = H5Dopen2(file, dataset, H5P_DEFAULT);
+  const hid_t space = H5Dget_space(set);
+  std::vector<hsize_t> start(rank, 0), count(rank, 1);
+  start[0] = 5;  // frame 5
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  const hid_t one = H5Screate_simple(1, count.data(), nullptr);
+  H5Dwrite(set, H5T_NATIVE_DOUBLE, one, space, H5P_DEFAULT, &value);
+  H5Sclose(one);
+  H5Sclose(space);
+  H5Dclose(set);
+  H5Fclose(file);
+}
+
+// Uploads are validated before they are kept: each refusal names what is wrong (the dataset, the
+// frame), the client exits 2 with the server's explanation, no partial file stays behind, and the
+// server keeps serving. The good database is then accepted.
+TEST_F(EndToEnd, InvalidUploadsAreRefusedNamingTheDatasetAndNothingIsKept) {
   auto server = start(0);
-  std::ofstream(tmp_->path() / "not.h5") << "this is not HDF5";
-  const auto r = client(*server, {"upload", (tmp_->path() / "not.h5").string()});
+  const auto dir = tmp_->path();
+  const auto databases = dir / "data" / "databases";
+  const auto refused = [&](const std::filesystem::path& file, int status, const std::string& says) {
+    const auto r = client(*server, {"upload", file.string()});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("HTTP " + std::to_string(status)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("incoming"), std::string::npos) << r.err;  // no server paths
+    EXPECT_TRUE(std::filesystem::is_empty(databases / "incoming"));
+    EXPECT_EQ(server->get("/v1/health").status, 200);
+  };
+  std::ofstream(dir / "not.h5") << "this is not HDF5";
+  refused(dir / "not.h5", 422, "not an HDF5 file");
+  std::ofstream(dir / "empty.h5").close();
+  refused(dir / "empty.h5", 400, "Empty upload");
+
+  std::filesystem::copy_file(dir / "db.h5", dir / "missing.h5");
+  const hid_t file = H5Fopen((dir / "missing.h5").c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(H5Ldelete(file, "/frames/u_g", H5P_DEFAULT), 0);
+  H5Fclose(file);
+  refused(dir / "missing.h5", 422, "/frames/u_g");
+
+  std::filesystem::copy_file(dir / "db.h5", dir / "nan.h5");
+  poke(dir / "nan.h5", "/frames/u_p", 5, std::nan(""));
+  refused(dir / "nan.h5", 422, "frame 5");
+
+  EXPECT_EQ(upload(*server).size(), 32u);
+  int kept = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(databases)) kept += entry.is_regular_file();
+  EXPECT_EQ(kept, 1);
+
+  // An upload over --max-upload-bytes is 413 before its body is read.
+  ServerProcess small(dir / "small", "e2e-token", {"--workers", "0", "--max-upload-bytes", "4096"});
+  const auto r = client(small, {"upload", (dir / "db.h5").string()});
   EXPECT_EQ(r.code, 2) << r.err;
-  EXPECT_NE(r.err.find("422"), std::string::npos) << r.err;
-  // Nothing was kept.
-  EXPECT_TRUE(std::filesystem::is_empty(tmp_->path() / "data" / "databases" / "incoming"));
+  EXPECT_NE(r.err.find("HTTP 413"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4096"), std::string::npos) << r.err;
+  const auto smallIncoming = dir / "small" / "databases" / "incoming";
+  EXPECT_TRUE(!std::filesystem::exists(smallIncoming) || std::filesystem::is_empty(smallIncoming));
+  EXPECT_EQ(small.get("/v1/health").status, 200);
 }
 
 }  // namespace
