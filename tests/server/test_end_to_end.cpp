@@ -149,11 +149,14 @@ class EndToEnd : public ::testing::Test {
     scene_ = withTracers(quickScene(), kTracers);
     writeSmallDatabase(scene_, tmp_->path() / "db.h5");
   }
-  std::unique_ptr<ServerProcess> start(int workers) {
+  // Solvers at the server's niceness by default here: ctest -j runs other tests of the same session
+  // beside these, and a niced solver would wait behind them (the suite's time, not what is tested).
+  std::unique_ptr<ServerProcess> start(int workers, int workerNice = 0) {
     return std::make_unique<ServerProcess>(
         tmp_->path() / "data", "e2e-token",
         std::vector<std::string>{"--workers", std::to_string(workers), "--solver",
-                                 (binaryDir() / "rcfd-solve").string(), "--shutdown-grace", "20"});
+                                 (binaryDir() / "rcfd-solve").string(), "--shutdown-grace", "20",
+                                 "--worker-nice", std::to_string(workerNice)});
   }
   std::string upload(const ServerProcess& server) {
     const auto r = client(server, {"upload", (tmp_->path() / "db.h5").string()});
@@ -221,8 +224,18 @@ TEST_F(EndToEnd, UploadSprayCoverageCsvAndH5EqualResultH5) {
   EXPECT_NE(std::find(artifacts.begin(), artifacts.end(), "summary.json"), artifacts.end());
 }
 
+/// The nice value of a process (/proc/PID/stat field 19).
+int niceOf(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), {});
+  std::istringstream rest(text.substr(text.rfind(')') + 2));
+  std::string field;
+  for (int i = 3; i <= 19; ++i) rest >> field;
+  return std::stoi(field);
+}
+
 TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
-  auto server = start(2);
+  auto server = start(2, 5);  // and the solvers run 5 nicer than the server
   const std::string db = upload(*server);
   const std::string victim = submit(*server, sprayJob(db, 1000.0, 1));  // far too long to finish
   const std::string other = submit(*server, sprayJob(db, 0.2, 2));
@@ -238,6 +251,7 @@ TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
     if (line.find(victim) != std::string::npos) victimPid = child;
   }
   ASSERT_GT(victimPid, 0);
+  EXPECT_EQ(niceOf(victimPid), std::min(19, niceOf(server->pid()) + 5));
   ASSERT_EQ(::kill(victimPid, SIGKILL), 0);
   const auto failed = pollJob(*server, victim, isFinal);
   EXPECT_EQ(failed.at("state"), "FAILED");
