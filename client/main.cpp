@@ -39,8 +39,11 @@ std::string envOr(const char* name, const std::string& fallback) {
     if (body.contains("detail") && body["detail"].is_string())
       std::cerr << "  " << body["detail"].get<std::string>() << "\n";
     if (body.contains("errors") && body["errors"].is_array())
-      for (const auto& e : body["errors"])
-        std::cerr << "  " << e.value("pointer", "") << ": " << e.value("message", "") << "\n";
+      for (const auto& e : body["errors"]) {
+        const std::string pointer = e.value("pointer", "");
+        std::cerr << "  " << (pointer.empty() ? "(whole document)" : pointer) << ": "
+                  << e.value("message", "") << "\n";
+      }
   } else {
     std::cerr << "\n" << (res.body.size() > 500 ? res.body.substr(0, 500) + "..." : res.body) << "\n";
   }

@@ -39,14 +39,20 @@ StringResponse DatabasesApi::accept(const std::filesystem::path& file, const Tar
     std::lock_guard lock(hdf5Mutex());
     const auto opened = FieldDatabase::open(file.string(), FrameStorage{kValidationCacheBytes});
     db.frames = opened->frameCount();
+    // Every frame is read once: a NaN or Inf is refused now (InputError naming the dataset and the
+    // frame), not when a spray job reaches that frame hours later.
+    for (int i = 0; i < db.frames; ++i) (void)opened->frame(i);
   } catch (const InputError& e) {
     std::filesystem::remove(file, ec);
-    return invalidInput(e, target.path);
+    // The source is "upload", not the server's temporary file name.
+    return invalidInput(InputError("upload", e.violations()), target.path);
   } catch (const std::exception& e) {
     std::filesystem::remove(file, ec);
+    std::string what = e.what();
+    for (auto at = what.find(file.string()); at != std::string::npos; at = what.find(file.string()))
+      what.replace(at, file.string().size(), "upload");
     return problem(http::status::unprocessable_entity, "invalid-database", "Invalid field database",
-                   std::string("the upload is not a readable field database: ") + e.what(),
-                   target.path);
+                   "the upload is not a readable field database: " + what, target.path);
   }
   db.id = newId();
   db.bytes = static_cast<std::int64_t>(bytes);

@@ -2,6 +2,7 @@
 
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
+#include <limits>
 
 #include "Problem.hpp"
 
@@ -34,10 +35,10 @@ void HttpSession::run() {
 void HttpSession::doRead() {
   header_.emplace();
   header_->header_limit(kHeaderLimit);
-  // The header parser checks Content-Length against its body limit; the route's own limit is
-  // applied once the route is known (onHeader).
-  header_->body_limit(std::max<std::uint64_t>(router_.config().uploadLimit,
-                                              router_.config().jsonBodyLimit));
+  // No limit here: the route's own limit is checked against Content-Length once the route is known
+  // (onHeader), and the route's body parser enforces it on chunked bodies.
+  // (Not boost::none: Beast 1.74 compares a Content-Length with an empty optional as "over".)
+  header_->body_limit(std::numeric_limits<std::uint64_t>::max());
   body_.reset();
   upload_.reset();
   stream_.expires_after(router_.config().readTimeout);
@@ -75,8 +76,17 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
   started_ = std::chrono::steady_clock::now();
   const auto& req = header_->get();
   const std::string_view target(req.target().data(), req.target().size());
+  const auto tooLarge = [&](std::uint64_t length, std::uint64_t limit) {
+    return problem(http::status::payload_too_large, "body-too-large", "Request body too large",
+                   "the body has " + std::to_string(length) + " bytes; the limit is " +
+                       std::to_string(limit),
+                   std::string(target));
+  };
+  const auto length = header_->content_length();
   if (Router::isUpload(req.method(), target)) {
     if (!router_.authorized(req)) return send(router_.unauthorized(std::string(target)), false);
+    if (length && *length > router_.config().uploadLimit)
+      return send(tooLarge(*length, router_.config().uploadLimit), false);
     upload_.emplace(std::move(*header_));
     upload_->body_limit(router_.config().uploadLimit);
     uploadPath_ = router_.databases().temporaryUploadPath();
@@ -91,15 +101,11 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
                      beast::bind_front_handler(&HttpSession::onUpload, shared_from_this()));
     return;
   }
-  const auto length = header_->content_length();
   if (length && *length > router_.config().jsonBodyLimit)
-    return send(problem(http::status::payload_too_large, "body-too-large", "Request body too large",
-                        "the body has " + std::to_string(*length) + " bytes; the limit is " +
-                            std::to_string(router_.config().jsonBodyLimit),
-                        std::string(target)),
-                false);
+    return send(tooLarge(*length, router_.config().jsonBodyLimit), false);
   body_.emplace(std::move(*header_));
   body_->body_limit(router_.config().jsonBodyLimit);
+  if (body_->is_done()) return onBody({}, 0);  // no body (a GET): answer without another read
   http::async_read(stream_, buffer_, *body_,
                    beast::bind_front_handler(&HttpSession::onBody, shared_from_this()));
 }

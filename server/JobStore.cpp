@@ -234,6 +234,15 @@ void JobStore::exec(const char* sql) {
   }
 }
 
+void JobStore::setChangeListener(std::function<void(const std::string& id)> listener) {
+  std::lock_guard lock(mutex_);
+  listener_ = std::move(listener);
+}
+
+void JobStore::changed(const std::string& id) {
+  if (listener_) listener_(id);
+}
+
 int JobStore::latestSchemaVersion() { return static_cast<int>(kMigrations.size()); }
 
 void JobStore::migrate() {
@@ -315,6 +324,7 @@ JobStore::InsertResult JobStore::insertJob(const JobRecord& job) {
   read.bind(1, job.id).step();
   JobRecord created = readJob(&read);
   tx.commit();
+  changed(job.id);
   return {created, true};
 }
 
@@ -364,6 +374,7 @@ bool JobStore::transition(const std::string& id, const std::string& from, const 
   if (sqlite3_changes(db_) == 0) return false;
   insertEvent(db_, id, from, to, reason.empty() ? error : reason, now);
   tx.commit();
+  changed(id);
   return true;
 }
 
@@ -385,6 +396,7 @@ bool JobStore::markStarted(const std::string& id) {
   if (sqlite3_changes(db_) == 0) return false;
   insertEvent(db_, id, state::queued, state::running, "worker started", now);
   tx.commit();
+  changed(id);
   return true;
 }
 
@@ -396,6 +408,7 @@ void JobStore::updateProgress(const std::string& id, double fraction, std::optio
               "updated_at = ?6 WHERE id = ?1");
   s.bind(1, id).bind(2, fraction).bind(3, simTime).bind(4, wallTime).bind(5, eta);
   s.bind(6, nowRfc3339()).run();
+  changed(id);
 }
 
 bool JobStore::markSucceeded(const std::string& id, const nlohmann::json& summary,
@@ -426,6 +439,7 @@ bool JobStore::markSucceeded(const std::string& id, const nlohmann::json& summar
   }
   insertEvent(db_, id, from, state::succeeded, "solver exited 0", now);
   tx.commit();
+  changed(id);
   return true;
 }
 

@@ -6,6 +6,7 @@
 /// Thread-safe: one connection guarded by a mutex (every statement is short).
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -121,7 +122,13 @@ class JobStore {
   /// Number of jobs in each state (every state present, zero if none).
   std::vector<std::pair<std::string, std::int64_t>> countByState();
 
+  /// Called with a job's id after every committed change of its row (insert, transition, start,
+  /// progress, success), under the store's lock: the listener must not call back into the store.
+  /// The server is the only writer of the database, so this sees every change (JobViewCache).
+  void setChangeListener(std::function<void(const std::string& id)> listener);
+
  private:
+  void changed(const std::string& id);
   void migrate();
   void exec(const char* sql);
   JobRecord readJob(void* statement);
@@ -129,6 +136,7 @@ class JobStore {
   std::mutex mutex_;
   sqlite3* db_ = nullptr;
   std::map<std::string, sqlite3_stmt*> statements_;  // prepared once, reused (under mutex_)
+  std::function<void(const std::string&)> listener_;
 };
 
 /// Current UTC time as RFC 3339 with milliseconds, e.g. 2026-11-22T02:40:00.123Z.

@@ -50,6 +50,13 @@ std::string contentTypeFor(const std::string& name) {
 
 }  // namespace
 
+JobsApi::JobsApi(JobStore& store, WorkerPool& pool, const ServerConfig& config)
+    : store_(store), pool_(pool), config_(config) {
+  store_.setChangeListener([this](const std::string& id) { views_.invalidate(id); });
+}
+
+JobsApi::~JobsApi() { store_.setChangeListener({}); }
+
 bool isArtifactName(const std::string& name) {
   for (const char* fixed : kFixedArtifacts)
     if (name == fixed) return true;
@@ -220,10 +227,17 @@ Response JobsApi::list(const Target& target) {
 }
 
 Response JobsApi::get(const std::string& id, const Target& target) {
+  const auto view = target.query.find("view");
+  const bool full = view != target.query.end() && view->second == "full";
+  if (!full)
+    if (const auto body = views_.find(id)) return textResponse(http::status::ok, *body, "application/json");
+  const auto generation = views_.generation();  // before the read: a write after it voids the body
   const auto job = store_.job(id);
   if (!job) return notFound(id, target);
-  const auto view = target.query.find("view");
-  return jsonResponse(http::status::ok, toJson(*job, view != target.query.end() && view->second == "full"));
+  if (full) return jsonResponse(http::status::ok, toJson(*job, true));
+  auto body = std::make_shared<const std::string>(jsonText(toJson(*job)));
+  views_.store(id, body, generation);
+  return textResponse(http::status::ok, *body, "application/json");
 }
 
 Response JobsApi::events(const std::string& id, const Target& target) {

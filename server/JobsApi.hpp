@@ -1,11 +1,13 @@
 #pragma once
 /// \file JobsApi.hpp
 /// Handlers of /v1/jobs: submit (validated with rcfd::loadJob, Idempotency-Key), list (filters,
-/// opaque page tokens), get, cancel, result, coverage and artifacts. Each handler only reads or
-/// writes rows and files; solvers run in the WorkerPool.
+/// opaque page tokens), get (answered from JobViewCache while the row is unchanged), cancel, result,
+/// coverage and artifacts. Each handler only reads or writes rows and files; solvers run in the
+/// WorkerPool.
 
 #include "HttpTypes.hpp"
 #include "JobStore.hpp"
+#include "JobViewCache.hpp"
 #include "ServerConfig.hpp"
 #include "Target.hpp"
 
@@ -15,8 +17,11 @@ class WorkerPool;
 
 class JobsApi {
  public:
-  JobsApi(JobStore& store, WorkerPool& pool, const ServerConfig& config)
-      : store_(store), pool_(pool), config_(config) {}
+  /// Registers the view cache as the store's change listener (until destruction).
+  JobsApi(JobStore& store, WorkerPool& pool, const ServerConfig& config);
+  ~JobsApi();
+  JobsApi(const JobsApi&) = delete;
+  JobsApi& operator=(const JobsApi&) = delete;
 
   Response submit(const Request& req, const Target& target);
   Response list(const Target& target);
@@ -37,6 +42,7 @@ class JobsApi {
   JobStore& store_;
   WorkerPool& pool_;
   const ServerConfig& config_;
+  JobViewCache views_;  // bodies of GET /v1/jobs/{id}
 };
 
 /// Whether `name` may be served from a job folder: a fixed list plus simple *.svg names.

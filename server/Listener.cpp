@@ -21,10 +21,11 @@ Listener::Listener(net::io_context& ioc, net::ip::tcp::endpoint endpoint, Router
 
 void Listener::run() { doAccept(); }
 
-void Listener::stop() {
-  net::post(acceptor_.get_executor(), [self = shared_from_this()] {
+void Listener::stop(std::function<void()> then) {
+  net::post(acceptor_.get_executor(), [self = shared_from_this(), then = std::move(then)] {
     boost::system::error_code ignored;
     self->acceptor_.close(ignored);
+    if (then) then();
   });
 }
 

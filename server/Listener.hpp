@@ -4,6 +4,7 @@
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/thread_pool.hpp>
+#include <functional>
 #include <memory>
 
 namespace rcfd::server {
@@ -18,8 +19,9 @@ class Listener : public std::enable_shared_from_this<Listener> {
   /// The bound endpoint (the real port when 0 was asked for).
   boost::asio::ip::tcp::endpoint endpoint() const { return acceptor_.local_endpoint(); }
   void run();
-  /// Stops accepting; open sessions finish their current exchange.
-  void stop();
+  /// Closes the listening socket (on its strand, so it never races an accept), then calls `then`:
+  /// from then on new connections are refused instead of queueing in a backlog nobody serves.
+  void stop(std::function<void()> then = {});
 
  private:
   void doAccept();

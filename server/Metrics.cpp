@@ -10,7 +10,6 @@ void Metrics::observe(double seconds, int status) {
   std::size_t i = 0;
   while (i < kBuckets.size() && seconds > kBuckets[i]) ++i;
   buckets_[i].fetch_add(1, std::memory_order_relaxed);
-  count_.fetch_add(1, std::memory_order_relaxed);
   sumMicros_.fetch_add(static_cast<std::uint64_t>(seconds * 1e6), std::memory_order_relaxed);
   const int cls = status / 100;
   if (cls >= 1 && cls <= 5) byClass_[static_cast<std::size_t>(cls)].fetch_add(1);
@@ -48,7 +47,8 @@ std::string Metrics::render(JobStore& store, int workersBusy, int workerSlots) c
   out << "rcfd_http_request_duration_seconds_bucket{le=\"+Inf\"} " << cumulative << "\n";
   out << "rcfd_http_request_duration_seconds_sum " << static_cast<double>(sumMicros_.load()) * 1e-6
       << "\n";
-  out << "rcfd_http_request_duration_seconds_count " << count_.load() << "\n";
+  // The count is the +Inf bucket as read above, so the two are always equal (Prometheus requires it).
+  out << "rcfd_http_request_duration_seconds_count " << cumulative << "\n";
   return out.str();
 }
 

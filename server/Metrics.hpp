@@ -26,7 +26,6 @@ class Metrics {
 
  private:
   std::array<std::atomic<std::uint64_t>, kBuckets.size() + 1> buckets_{};  // last: +Inf
-  std::atomic<std::uint64_t> count_{0};
   std::atomic<std::uint64_t> sumMicros_{0};
   std::array<std::atomic<std::uint64_t>, 6> byClass_{};  // 1xx..5xx, index 0 unused
 };

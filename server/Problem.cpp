@@ -11,7 +11,7 @@ StringResponse problem(http::status status, const std::string& type, const std::
                          {"detail", detail},
                          {"instance", instance}};
   if (!errors.is_null()) body["errors"] = errors;
-  return textResponse(status, body.dump(2) + "\n", "application/problem+json");
+  return textResponse(status, jsonText(body), "application/problem+json");
 }
 
 StringResponse invalidInput(const InputError& error, const std::string& instance) {
@@ -25,8 +25,10 @@ StringResponse invalidInput(const InputError& error, const std::string& instance
                  instance, errors);
 }
 
+std::string jsonText(const nlohmann::json& body) { return body.dump() + "\n"; }
+
 StringResponse jsonResponse(http::status status, const nlohmann::json& body) {
-  return textResponse(status, body.dump(2) + "\n", "application/json");
+  return textResponse(status, jsonText(body), "application/json");
 }
 
 StringResponse textResponse(http::status status, std::string body, const std::string& contentType) {

@@ -22,6 +22,9 @@ StringResponse invalidInput(const InputError& error, const std::string& instance
 
 /// A JSON body with the given status (application/json).
 StringResponse jsonResponse(http::status status, const nlohmann::json& body);
+/// The body text jsonResponse sends: compact JSON (clients parse it; no indentation to write and
+/// send) and a final newline for terminals.
+std::string jsonText(const nlohmann::json& body);
 
 /// A plain body with an explicit content type.
 StringResponse textResponse(http::status status, std::string body, const std::string& contentType);

@@ -13,6 +13,7 @@ struct ServerConfig {
   std::filesystem::path dataDir;      ///< rcfd.sqlite, jobs/<id>/, databases/
   std::string token;                  ///< bearer token required on everything but /v1/health
   int workers = 1;                    ///< concurrent solver processes (0: jobs stay QUEUED)
+  int workerNice = 10;                ///< solvers run this much nicer than the server [0, 19]
   std::filesystem::path solverPath;   ///< the rcfd-solve executable
   std::uint64_t jsonBodyLimit = 1u << 20;            ///< bytes of a JSON request body
   std::uint64_t uploadLimit = 8ull << 30;            ///< bytes of an uploaded database

@@ -1,8 +1,10 @@
 #include "WorkerPool.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -205,10 +207,32 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
     std::vector<const char*> argv = {solver.c_str(), "run", jobFile.c_str(), "--out",
                                      outDir.c_str(), "--progress-json", nullptr};
     const pid_t parent = ::getpid();
+    // Solvers are batch work: nicer than the server, whose I/O threads answer polls in microseconds
+    // and would otherwise queue behind a solver's threads for a scheduler slice.
+    const int solverNice = std::min(19, ::getpriority(PRIO_PROCESS, 0) + config_.workerNice);
+    // The child starts as a copy of the server, signal handlers included: Asio's SIGTERM handler
+    // writes into the server's signal pipe, so a cancel (SIGTERM) reaching the child before exec
+    // would shut the *server* down. So fork with every signal blocked, and let the child restore
+    // default dispositions before it unblocks them (what posix_spawn's SETSIGDEF does).
+    sigset_t all, previous;
+    ::sigfillset(&all);
+    ::pthread_sigmask(SIG_BLOCK, &all, &previous);
     pid = ::fork();
     if (pid == 0) {
       // Child: only async-signal-safe calls until exec.
+      struct sigaction byDefault {};
+      byDefault.sa_handler = SIG_DFL;
+      ::sigemptyset(&byDefault.sa_mask);
+      for (int sig = 1; sig < NSIG; ++sig)
+        if (sig != SIGKILL && sig != SIGSTOP) ::sigaction(sig, &byDefault, nullptr);
+      // SIGPIPE stays ignored, as in the server: a solver whose server died must get EPIPE on its
+      // progress pipe and go on to checkpoint on the PDEATHSIG SIGTERM, not die of SIGPIPE first.
+      ::signal(SIGPIPE, SIG_IGN);
+      sigset_t none;
+      ::sigemptyset(&none);
+      ::sigprocmask(SIG_SETMASK, &none, nullptr);  // a pending SIGTERM now ends the child: cancelled
       ::setpgid(0, 0);                      // a terminal's Ctrl-C reaches the server only
+      ::setpriority(PRIO_PROCESS, 0, solverNice);  // the solver's threads inherit it
       ::prctl(PR_SET_PDEATHSIG, SIGTERM);   // server gone -> checkpoint and exit 130
       if (::getppid() != parent) ::_exit(130);
       const int devnull = ::open("/dev/null", O_RDONLY);
@@ -223,6 +247,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       (void)!::write(2, msg, sizeof msg - 1);
       ::_exit(127);
     }
+    ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
     ::close(pipeFds[1]);
     if (pid < 0) {
       setupError = std::string("fork failed: ") + std::strerror(errno);
@@ -351,6 +376,9 @@ void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::stri
 }
 
 void WorkerPool::shutdown() {
+  // One shutdown at a time (the signal handler's and main's, then the destructor's): a second caller
+  // waits for the first and then finds nothing left to do.
+  std::lock_guard once(shutdownMutex_);
   std::map<std::uint64_t, std::thread> threads;
   {
     std::lock_guard lock(mutex_);

@@ -50,6 +50,7 @@ class WorkerPool {
   JobStore& store_;
   const ServerConfig& config_;
   std::mutex mutex_;
+  std::mutex shutdownMutex_;  // serialises shutdown() calls
   std::condition_variable wake_;
   bool stopping_ = false;
   bool pending_ = false;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/thread_pool.hpp>
@@ -100,6 +101,9 @@ int main(int argc, char** argv) {
   app.add_option("--token-file", tokenFile, "file holding the bearer token (else RCFD_TOKEN, else DIR/token)");
   app.add_option("--workers", config.workers, "concurrent solver processes; 0 keeps jobs queued")->capture_default_str()
       ->check(CLI::Range(0, 1024));
+  app.add_option("--worker-nice", config.workerNice,
+                 "niceness added to solver processes, so HTTP answers do not wait behind them")
+      ->capture_default_str()->check(CLI::Range(0, 19));
   app.add_option("--solver", solver, "rcfd-solve executable (default: beside rcfd-server)");
   app.add_option("--io-threads", ioThreads, "threads serving HTTP")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-body-bytes", maxBody, "limit of a JSON request body")->capture_default_str();
@@ -130,13 +134,19 @@ int main(int argc, char** argv) {
     auto listener = std::make_shared<Listener>(ioc, parseListen(listen), router, blocking);
     // Signals are caught before the listening line is printed, so a supervisor that reads it can
     // always stop the server gracefully.
+    // Shutdown: refuse new connections, keep answering the open ones (status polls see the jobs
+    // go back to QUEUED) while the solvers checkpoint, and only then stop the io threads.
     net::signal_set signals(ioc, SIGINT, SIGTERM);
     signals.async_wait([&](const boost::system::error_code& ec, int sig) {
       if (ec) return;
       std::cerr << "rcfd-server: signal " << sig
                 << ": stopping; running solvers checkpoint and resume on the next start\n";
-      listener->stop();
-      ioc.stop();
+      listener->stop([&] {
+        net::post(blocking, [&] {  // waits up to the grace period: never on an io thread
+          pool.shutdown();
+          ioc.stop();
+        });
+      });
     });
     const auto bound = listener->endpoint();
     const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]"
@@ -146,6 +156,8 @@ int main(int argc, char** argv) {
               << " worker slot(s), solver " << config.solverPath.string() << "\n";
     pool.start();
     listener->run();
+    // The io threads run until the shutdown handler stops them, even when no connection is open.
+    auto keepRunning = net::make_work_guard(ioc);
 
     std::vector<std::thread> threads;
     for (int i = 1; i < ioThreads; ++i) threads.emplace_back([&ioc] { ioc.run(); });

@@ -1,7 +1,8 @@
 #pragma once
 // A small loopback load generator (Boost.Beast, asynchronous): `connections` keep-alive connections
 // each sending GET `target` until `duration` has passed, either back to back (interval 0: measures
-// the server at saturation) or one request per `interval` per client (a polling client). Used by tests/server/test_load
+// the server at saturation) or one request per `interval` per client (a polling client; the clients'
+// first requests are spread evenly over one interval, so they do not all poll in the same instant). Used by tests/server/test_load
 // (5 s) and bench/server_load.cpp (30 s). Header-only so both can include it.
 
 #include <algorithm>
@@ -56,13 +57,17 @@ class LoadConnection : public std::enable_shared_from_this<LoadConnection> {
     shared_.latenciesMs.insert(shared_.latenciesMs.end(), latencies_.begin(), latencies_.end());
     shared_.errors += errors_;
   }
-  void start() {
-    stream_.async_connect(endpoint_, [self = shared_from_this()](beast::error_code ec) {
+  /// Connects, then sends the first request after `offset` (polling clients are spread over one
+  /// interval, as independent clients are, instead of all asking in the same instant).
+  void start(std::chrono::steady_clock::duration offset) {
+    stream_.async_connect(endpoint_, [self = shared_from_this(), offset](beast::error_code ec) {
       if (ec) {
         ++self->errors_;
         return;
       }
-      self->send();
+      if (offset.count() == 0) return self->send();
+      self->timer_.expires_after(offset);
+      self->timer_.async_wait([self](beast::error_code) { self->send(); });
     });
   }
 
@@ -123,7 +128,8 @@ inline LoadResult runStatusLoad(unsigned short port, const std::string& token, c
   shared.interval = interval;
   const net::ip::tcp::endpoint endpoint(net::ip::make_address("127.0.0.1"), port);
   for (int i = 0; i < connections; ++i)
-    std::make_shared<detail::LoadConnection>(ioc, shared, endpoint, target, token)->start();
+    std::make_shared<detail::LoadConnection>(ioc, shared, endpoint, target, token)
+        ->start(std::chrono::steady_clock::duration(interval) * i / connections);
   std::vector<std::thread> pool;
   for (int i = 1; i < threads; ++i) pool.emplace_back([&ioc] { ioc.run(); });
   ioc.run();

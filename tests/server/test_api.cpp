@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <sstream>
+
 #include "ServerFixture.hpp"
 
 using namespace rcfd::test;
@@ -141,7 +144,7 @@ TEST_F(Api, ArtifactPathsAreRefused) {
   for (const std::string name : {"../../rcfd.sqlite", "..%2F..%2Frcfd.sqlite", "..", "token",
                                  "rcfd.sqlite", "%2e%2e%2ftoken", "x/../../token"}) {
     const auto r = server_->get(base + name);
-    EXPECT_TRUE(r.status == 400 || r.status == 404) << name << " -> " << r.status;
+    EXPECT_EQ(r.status, 400) << name;  // refused by name, before any file is looked at
     EXPECT_EQ(r.header("content-type"), "application/problem+json") << name;
     EXPECT_EQ(r.body.find("test-token-123"), std::string::npos);
   }
@@ -174,6 +177,12 @@ TEST_F(Api, IdempotencyKeyReturnsSameJobAndRefusesDifferentBody) {
   ASSERT_EQ(first.status, 202);
   ASSERT_EQ(second.status, 202);
   EXPECT_EQ(first.json().at("id"), second.json().at("id"));
+  EXPECT_EQ(first.header("idempotent-replayed"), "");
+  EXPECT_EQ(second.header("idempotent-replayed"), "true");
+  // The key matches the JSON document, not its spelling: reordered keys are the same body.
+  const auto respelled = server_->post("/v1/jobs", databaseJob(1).dump(2), key);
+  EXPECT_EQ(respelled.status, 202);
+  EXPECT_EQ(respelled.json().at("id"), first.json().at("id"));
   const auto all = server_->get("/v1/jobs").json();
   EXPECT_EQ(all.at("jobs").size(), 1u);
   const auto different = server_->post("/v1/jobs", databaseJob(2).dump(), key);
@@ -227,10 +236,18 @@ TEST_F(Api, FiltersByStateAndKind) {
 
 TEST_F(Api, CancelQueuedJobAtOnceAndRecordsEvents) {
   const std::string id = server_->post("/v1/jobs", databaseJob().dump()).json().at("id");
+  // Polled twice while QUEUED (the second answer comes from the view cache) ...
+  EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "QUEUED");
+  EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "QUEUED");
   const auto r = server_->post("/v1/jobs/" + id + ":cancel", "");
   ASSERT_EQ(r.status, 200) << r.body;
   EXPECT_EQ(r.json().at("state"), "CANCELLED");
   EXPECT_FALSE(r.json().at("finished_at").is_null());
+  // ... and the next poll sees the change at once, in both views.
+  const auto polled = server_->get("/v1/jobs/" + id).json();
+  EXPECT_EQ(polled.at("state"), "CANCELLED");
+  EXPECT_EQ(polled, r.json());
+  EXPECT_EQ(server_->get("/v1/jobs/" + id + "?view=full").json().at("state"), "CANCELLED");
   // Cancelling a finished job is a conflict.
   expectProblem(server_->post("/v1/jobs/" + id + ":cancel", ""), 409);
   const auto events = server_->get("/v1/jobs/" + id + "/events").json().at("events");
@@ -251,6 +268,39 @@ TEST_F(Api, MetricsExposeJobGaugesAndLatencyHistogram) {
   EXPECT_NE(r.body.find("rcfd_queue_length 2"), std::string::npos);
   EXPECT_NE(r.body.find("rcfd_http_request_duration_seconds_bucket{le=\"+Inf\"}"), std::string::npos);
   EXPECT_NE(r.body.find("rcfd_http_requests_total{code=\"2xx\"}"), std::string::npos);
+
+  // The histogram is consistent: buckets cumulative, +Inf = count; every answered request (the 2
+  // submits, the /metrics above and one 404) counted by status class. A request is
+  // counted once its response is written, which may be just after the client has read it: poll.
+  expectProblem(server_->get("/v1/jobs/00000000000000000000000000000000"), 404);
+  std::map<std::string, double> samples;
+  std::vector<double> buckets;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    samples.clear();
+    buckets.clear();
+    std::istringstream lines(server_->get("/metrics").body);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      const auto space = line.rfind(' ');
+      const double value = std::stod(line.substr(space + 1));
+      samples[line.substr(0, space)] = value;
+      if (line.rfind("rcfd_http_request_duration_seconds_bucket", 0) == 0) buckets.push_back(value);
+    }
+    if (samples["rcfd_http_requests_total{code=\"4xx\"}"] >= 1 &&
+        samples["rcfd_http_requests_total{code=\"2xx\"}"] >= 3)
+      break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(buckets.size(), 13u);  // 12 bounds and +Inf
+  EXPECT_TRUE(std::is_sorted(buckets.begin(), buckets.end()));
+  const double count = samples.at("rcfd_http_request_duration_seconds_count");
+  EXPECT_EQ(buckets.back(), count);
+  EXPECT_EQ(samples.at("rcfd_http_requests_total{code=\"4xx\"}"), 1);
+  EXPECT_GE(samples.at("rcfd_http_requests_total{code=\"2xx\"}"), 3);
+  EXPECT_EQ(samples.at("rcfd_http_requests_total{code=\"5xx\"}"), 0);
+  EXPECT_GE(count, 4);  // the polls of /metrics add to it
+  EXPECT_GT(samples.at("rcfd_http_request_duration_seconds_sum"), 0);
+  EXPECT_EQ(samples.at("rcfd_workers_busy"), 0);
 }
 
 TEST_F(Api, ServesEmbeddedSchemas) {

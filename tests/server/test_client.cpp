@@ -124,6 +124,29 @@ TEST_F(Client, ErrorsAreExplainedWithExitCodes) {
   auto down = runClient({"jobs"}, {"RCFD_SERVER=http://127.0.0.1:1", "RCFD_TOKEN=x"});
   EXPECT_EQ(down.code, 1);
   EXPECT_NE(down.err.find("cannot connect"), std::string::npos) << down.err;
+  // A queued job has no result yet: 409, exit 1, saying which state it is in.
+  const std::string queued = firstLine(runClient({"submit", (tmp_->path() / "job.json").string()}, env()).out);
+  auto early = runClient({"result", queued}, env());
+  EXPECT_EQ(early.code, 1);
+  EXPECT_NE(early.err.find("HTTP 409"), std::string::npos) << early.err;
+  EXPECT_NE(early.err.find("QUEUED"), std::string::npos) << early.err;
+  // A path as artifact name: 400, exit 2, nothing written; a listed name not produced: 404, exit 1.
+  const auto out = (tmp_->path() / "got").string();
+  auto path = runClient({"download", queued, "../token", "-o", out}, env());
+  EXPECT_EQ(path.code, 2);
+  EXPECT_NE(path.err.find("HTTP 400"), std::string::npos) << path.err;
+  EXPECT_NE(path.err.find("never"), std::string::npos) << path.err;  // "paths are never accepted"
+  auto absent = runClient({"download", queued, "result.h5", "-o", out}, env());
+  EXPECT_EQ(absent.code, 1);
+  EXPECT_NE(absent.err.find("HTTP 404"), std::string::npos) << absent.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // The same Idempotency-Key with another body: 422, exit 2, naming the job that holds the key.
+  ASSERT_EQ(runClient({"submit", (tmp_->path() / "job.json").string(), "--idempotency-key", "k"}, env()).code, 0);
+  std::ofstream(tmp_->path() / "other.json")
+      << nlohmann::json{{"kind", "database"}, {"scene", quickScene()}, {"seed", 4}}.dump();
+  auto reused = runClient({"submit", (tmp_->path() / "other.json").string(), "--idempotency-key", "k"}, env());
+  EXPECT_EQ(reused.code, 2);
+  EXPECT_NE(reused.err.find("HTTP 422 Idempotency-Key reused"), std::string::npos) << reused.err;
   // Usage error: exit 2.
   EXPECT_EQ(runClient({"coverage", "abc", "--format", "xml", "-o", "x"}, env()).code, 2);
   // Missing scene_file: exit 2 naming the pointer.
