@@ -1,7 +1,7 @@
 // End to end with the real solver: rcfd-server runs `rcfd-solve run` children. A field database is
-// written with rcfd::writeAnalyticDatabase (SmallDatabase.hpp; the CFD-DEM database runner is not used
-// here), uploaded with the client, a spray job runs on it, and the coverage downloaded as CSV and as
-// HDF5 equals the histogram in the job's result.h5. Also: kill -9 of a solver fails only its job;
+// written with rcfd::writeAnalyticDatabase (SmallDatabase.hpp) and uploaded with the client, or made
+// by a database job; a spray job runs on it, and the coverage downloaded as CSV and as HDF5 equals the
+// histogram in the job's result.h5. Also: kill -9 of a solver fails only its job;
 // kill -9 of the server, restart, and the job resumes from its checkpoint to the same result.
 
 #include <gtest/gtest.h>
@@ -428,6 +428,76 @@ TEST_F(EndToEnd, InvalidUploadsAreRefusedNamingTheDatasetAndNothingIsKept) {
   const auto smallIncoming = dir / "small" / "databases" / "incoming";
   EXPECT_TRUE(!std::filesystem::exists(smallIncoming) || std::filesystem::is_empty(smallIncoming));
   EXPECT_EQ(small.get("/v1/health").status, 200);
+}
+
+/// The first frame count of a database file's /frames/alpha_p ([N][nz][ny][nx]); -1 if unreadable.
+long frameCount(const std::filesystem::path& path) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) return -1;
+  long frames = -1;
+  const hid_t set = H5Dopen2(file, "/frames/alpha_p", H5P_DEFAULT);
+  if (set >= 0) {
+    const hid_t space = H5Dget_space(set);
+    hsize_t dims[4] = {0, 0, 0, 0};
+    if (H5Sget_simple_extent_ndims(space) == 4 && H5Sget_simple_extent_dims(space, dims, nullptr) == 4)
+      frames = long(dims[0]);
+    H5Sclose(space);
+    H5Dclose(set);
+  }
+  H5Fclose(file);
+  return frames;
+}
+
+// The whole chain on the server: a small database job (the built-in DEM of a box, no gas, so it takes
+// seconds) and a spray job submitted at once on the database job's id. The spray job waits for the
+// database, runs on its frames, and its coverage downloads equal its result.h5.
+TEST_F(EndToEnd, DatabaseJobThenSprayJobOnItsId) {
+  auto server = start(1);
+  nlohmann::json scene = nlohmann::json::parse(R"({
+    "name": "e2e-database",
+    "apparatus": {"type": "box", "size": [0.04, 0.1, 0.02]},
+    "grid": {"cell_size": 0.005},
+    "gas": {},
+    "particles": {"diameter": 0.003, "density": 1040.0},
+    "process": {"bed_mass": 0.005},
+    "spray": {"nozzle_position": [0.0, 0.002, 0.01], "nozzle_diameter": 0.002, "parcels_per_s": 2000,
+              "spray_zone": {"apex": [0.0, 0.0, 0.01], "half_angle_deg": 30, "y_min": 0.004, "y_max": 0.03}},
+    "dem": {"time_step": 2e-5, "coupling_interval": 5, "settle_time": 0.1, "ramp_time": 0.0, "warmup": 0.01,
+            "sample_rate": 200, "probe_rate": 1000, "sample_duration": 0.1, "reference_duration": 0.02},
+    "rcfd": {"tracers": 200},
+    "effects": ["rolling_friction"],
+    "outputs": {"svg": false}
+  })");
+  const std::string db = submit(*server, {{"kind", "database"}, {"scene", scene}, {"seed", 3}});
+  nlohmann::json sprayScene = scene;
+  sprayScene["effects"] = {"transport", "walls", "tracer_volume_fraction", "spray", "deposition", "coverage"};
+  nlohmann::json sprayOnDb = sprayJob(db, 0.25);
+  sprayOnDb["scene"] = sprayScene;
+  const std::string spray = submit(*server, sprayOnDb);
+
+  const auto job = pollJob(*server, spray, isFinal, std::chrono::seconds(180));
+  ASSERT_EQ(job.at("state"), "SUCCEEDED") << job.dump(2) << server->stderrText();
+  const auto database = server->get("/v1/jobs/" + db).json();
+  EXPECT_EQ(database.at("state"), "SUCCEEDED") << database.dump(2);
+  EXPECT_EQ(database.at("kind"), "database");
+
+  const auto dir = tmp_->path();
+  ASSERT_EQ(client(*server, {"download", db, "database.h5", "-o", (dir / "d.h5").string()}).code, 0);
+  EXPECT_EQ(frameCount(dir / "d.h5"), 20);  // 0.1 s at 200 Hz
+  const auto dbSummary = nlohmann::json::parse(client(*server, {"result", db}).out);
+  EXPECT_EQ(dbSummary.at("frames"), 20);
+  EXPECT_GT(dbSummary.at("particles").get<long>(), 0);
+
+  ASSERT_EQ(client(*server, {"coverage", spray, "--format", "csv", "-o", (dir / "c.csv").string()}).code, 0);
+  ASSERT_EQ(client(*server, {"download", spray, "result.h5", "-o", (dir / "r.h5").string()}).code, 0);
+  const Histogram reference = readH5(dir / "r.h5", "/coverage/histogram_edges", "/coverage/histogram_counts");
+  ASSERT_FALSE(reference.counts.empty());
+  const Histogram csv = readCsv(dir / "c.csv");
+  EXPECT_EQ(csv.edges, reference.edges);
+  EXPECT_EQ(csv.counts, reference.counts);
+  double tracers = 0;
+  for (double c : reference.counts) tracers += c;
+  EXPECT_EQ(tracers, double(kTracers));
 }
 
 }  // namespace
