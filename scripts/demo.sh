@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds, and runs the main job on the embedded defaults:
-# validates the example scenes and draws the apparatus of each into demo/.
+# Installs dependencies, builds, and runs the main job on the embedded defaults: the quick pipeline
+# through the job server (scripts/pipeline.sh): rcfd-server with a local data dir, database ->
+# calibration -> spray on examples/quick.json submitted with the rcfd client, progress shown, the
+# coverage distribution (CSV, HDF5) and its SVG downloaded into demo/. Also draws each example
+# apparatus into demo/. On 2 idle cores it takes about 30-40 minutes, mostly the CFD-DEM database job.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -10,5 +13,6 @@ for scene in examples/*.json; do
   name=$(basename "$scene" .json)
   ./build/rcfd-solve validate "$scene"
   ./build/rcfd-solve geometry "$scene" --svg "demo/$name.svg" --vtk "demo/$name.vtk"
-  echo "drew demo/$name.svg"
 done
+echo "drew demo/<example>.svg for every example scene"
+bash scripts/pipeline.sh
