@@ -6,22 +6,10 @@
 #include "cfddem/DemSystem.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
+#include "core/Vec3Packing.hpp"
 
 namespace rcfd {
 namespace {
-
-std::vector<double> flatten(const std::vector<Eigen::Vector3d>& v) {
-  std::vector<double> out(3 * v.size());
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int a = 0; a < 3; ++a) out[3 * i + std::size_t(a)] = v[i][a];
-  return out;
-}
-
-std::vector<Eigen::Vector3d> unflatten(const std::vector<double>& v) {
-  std::vector<Eigen::Vector3d> out(v.size() / 3);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
-  return out;
-}
 
 template <class Int>
 std::vector<std::int64_t> widen(const std::vector<Int>& v) {
@@ -38,12 +26,12 @@ std::vector<Int> narrow(const std::vector<std::int64_t>& v) {
 void DemSystem::saveState(h5::File& file, const std::string& group) const {
   const DemParticles& p = particles_;
   file.createGroup(group);
-  file.write(group + "/x", flatten(p.x));
-  file.write(group + "/v", flatten(p.v));
-  file.write(group + "/omega", flatten(p.omega));
-  file.write(group + "/force", flatten(p.force));
-  file.write(group + "/torque", flatten(p.torque));
-  file.write(group + "/fluid_force", flatten(p.fluid_force));
+  file.write(group + "/x", flattenVec3(p.x));
+  file.write(group + "/v", flattenVec3(p.v));
+  file.write(group + "/omega", flattenVec3(p.omega));
+  file.write(group + "/force", flattenVec3(p.force));
+  file.write(group + "/torque", flattenVec3(p.torque));
+  file.write(group + "/fluid_force", flattenVec3(p.fluid_force));
   file.write(group + "/radius", p.radius);
   file.write(group + "/mass", p.mass);
   file.write(group + "/inv_mass", p.inv_mass);
@@ -53,15 +41,15 @@ void DemSystem::saveState(h5::File& file, const std::string& group) const {
   file.createGroup(l);
   file.write(l + "/row_start", widen(list_.row_start));
   file.write(l + "/j", widen(list_.j));
-  file.write(l + "/shear", flatten(list_.shear));
+  file.write(l + "/shear", flattenVec3(list_.shear));
   file.write(l + "/col_start", widen(list_.col_start));
   file.write(l + "/col_pair", widen(list_.col_pair));
   file.write(l + "/wall_start", widen(list_.wall_start));
   file.write(l + "/wall_id", widen(list_.wall_id));
-  file.write(l + "/x_at_build", flatten(list_.positionsAtBuild()));
+  file.write(l + "/x_at_build", flattenVec3(list_.positionsAtBuild()));
   file.setAttribute(l, "builds", std::int64_t(list_.builds()));
   file.write(group + "/wall_history_wall", widen(wall_history_.wall));
-  file.write(group + "/wall_history_shear", flatten(wall_history_.shear));
+  file.write(group + "/wall_history_shear", flattenVec3(wall_history_.shear));
   file.setAttribute(group, "time", time_);
   file.setAttribute(group, "steps", std::int64_t(steps_));
   file.setAttribute(group, "builds_since_sort", std::int64_t(builds_since_sort_));
@@ -71,10 +59,10 @@ void DemSystem::saveState(h5::File& file, const std::string& group) const {
 
 void DemSystem::loadState(const h5::File& file, const std::string& group) {
   DemParticles& p = particles_;
-  p.x = unflatten(file.readDoubles(group + "/x"));
+  p.x = unflattenVec3(file.readDoubles(group + "/x"));
   const std::size_t n = p.x.size();
   auto vec3 = [&](const std::string& name) {
-    auto v = unflatten(file.readDoubles(group + "/" + name));
+    auto v = unflattenVec3(file.readDoubles(group + "/" + name));
     if (v.size() != n)
       throw RunError("DEM checkpoint " + file.path() + ":" + group + "/" + name + " has " +
                      std::to_string(v.size()) + " entries for " + std::to_string(n) + " particles");
@@ -96,15 +84,15 @@ void DemSystem::loadState(const h5::File& file, const std::string& group) {
   const std::string l = group + "/list";
   list_.row_start = narrow<NeighbourList::Index>(file.readInt64s(l + "/row_start"));
   list_.j = narrow<NeighbourList::Index>(file.readInt64s(l + "/j"));
-  list_.shear = unflatten(file.readDoubles(l + "/shear"));
+  list_.shear = unflattenVec3(file.readDoubles(l + "/shear"));
   list_.col_start = narrow<NeighbourList::Index>(file.readInt64s(l + "/col_start"));
   list_.col_pair = narrow<NeighbourList::Index>(file.readInt64s(l + "/col_pair"));
   list_.wall_start = narrow<NeighbourList::Index>(file.readInt64s(l + "/wall_start"));
   list_.wall_id = narrow<NeighbourList::Index>(file.readInt64s(l + "/wall_id"));
-  list_.restore(unflatten(file.readDoubles(l + "/x_at_build")), long(file.intAttribute(l, "builds")));
+  list_.restore(unflattenVec3(file.readDoubles(l + "/x_at_build")), long(file.intAttribute(l, "builds")));
   pair_forces_.resize(list_.pairs());
   wall_history_.wall = narrow<int>(file.readInt64s(group + "/wall_history_wall"));
-  wall_history_.shear = unflatten(file.readDoubles(group + "/wall_history_shear"));
+  wall_history_.shear = unflattenVec3(file.readDoubles(group + "/wall_history_shear"));
   if (wall_history_.wall.size() != n * WallHistory::slots || wall_history_.shear.size() != n * WallHistory::slots)
     throw RunError("DEM checkpoint " + file.path() + ":" + group + ": wall history does not match the particles");
   time_ = file.doubleAttribute(group, "time");

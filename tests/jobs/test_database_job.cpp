@@ -16,15 +16,19 @@
 #include <numbers>
 
 #include "analysis/ReferenceStatistics.hpp"
+#include "SolveProcess.hpp"
 #include "core/Hdf5.hpp"
 #include "fields/FieldDatabase.hpp"
 
 using nlohmann::json;
 namespace fs = std::filesystem;
 
+using rcfd::test::kSolver;
+using rcfd::test::solve;
+using rcfd::test::SolveResult;
+
 namespace {
 
-const std::string kSolver = std::string(RCFD_BINARY_DIR) + "/rcfd-solve";
 constexpr double kParcelDiameter = 0.003;
 constexpr double kDensity = 1040.0;
 constexpr double kBedMass = 0.005;  // 340 parcels of 3 mm
@@ -46,22 +50,6 @@ json sceneDocument() {
     "outputs": {"svg": true}
   })");
   return s;
-}
-
-struct SolveResult {
-  int exitCode = -1;
-  std::string out;
-};
-
-SolveResult solve(const std::string& args, bool withStderr = false) {
-  SolveResult r;
-  FILE* pipe = popen((kSolver + " " + args + (withStderr ? " 2>&1" : " 2>/dev/null")).c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) r.out += buffer;
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
 }
 
 class DatabaseJob : public testing::Test {

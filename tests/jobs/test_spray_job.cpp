@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
 
+#include "SolveProcess.hpp"
 #include "core/Hdf5.hpp"
 #include "fields/AnalyticDatabase.hpp"
 #include "geometry/Apparatus.hpp"
@@ -16,9 +17,12 @@
 using nlohmann::json;
 namespace fs = std::filesystem;
 
+using rcfd::test::kSolver;
+using rcfd::test::solve;
+using rcfd::test::SolveResult;
+
 namespace {
 
-const std::string kSolver = std::string(RCFD_BINARY_DIR) + "/rcfd-solve";
 
 json sceneDocument() {
   return json::parse(R"({
@@ -34,22 +38,6 @@ json sceneDocument() {
     "effects": ["transport", "walls", "fluctuation", "free_flight", "tracer_volume_fraction", "probes",
                 "residence_time", "spray", "deposition", "coverage", "deposition_maps"]
   })");
-}
-
-struct SolveResult {
-  int exitCode = -1;
-  std::string out;
-};
-
-SolveResult solve(const std::string& args) {
-  SolveResult r;
-  FILE* pipe = popen((kSolver + " " + args + " 2>/dev/null").c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) r.out += buffer;
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
 }
 
 class SprayJob : public testing::Test {

@@ -6,6 +6,7 @@
 #include "cfddem/gas/GasSolver.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
+#include "core/Vec3Packing.hpp"
 
 namespace rcfd::gas {
 
@@ -20,19 +21,6 @@ void GasSolver::setFlowFactor(double factor) {
   for (std::size_t c = 0; c < source_.size(); ++c) source_[c] = factor * source0_[c];
 }
 
-namespace {
-std::vector<double> flatten(const std::vector<Eigen::Vector3d>& v) {
-  std::vector<double> out(3 * v.size());
-  for (std::size_t i = 0; i < v.size(); ++i)
-    for (int a = 0; a < 3; ++a) out[3 * i + std::size_t(a)] = v[i][a];
-  return out;
-}
-std::vector<Eigen::Vector3d> unflatten(const std::vector<double>& v) {
-  std::vector<Eigen::Vector3d> out(v.size() / 3);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
-  return out;
-}
-}  // namespace
 
 void GasSolver::saveState(h5::File& file, const std::string& group) const {
   file.createGroup(group);
@@ -43,8 +31,8 @@ void GasSolver::saveState(h5::File& file, const std::string& group) const {
   file.write(group + "/alpha_next", alphaNext_);
   file.write(group + "/dalpha_dt", dAlphaDt_);
   file.write(group + "/beta", beta_);
-  file.write(group + "/u_particle", flatten(uParticle_));
-  file.write(group + "/f_explicit", flatten(fExplicit_));
+  file.write(group + "/u_particle", flattenVec3(uParticle_));
+  file.write(group + "/f_explicit", flattenVec3(fExplicit_));
   file.setAttribute(group, "time", time_);
   file.setAttribute(group, "last_dt", lastDt_);
   file.setAttribute(group, "flow_factor", flowFactor_);
@@ -68,8 +56,8 @@ void GasSolver::loadState(const h5::File& file, const std::string& group) {
   alphaNext_ = readSized("alpha_next", cells);
   dAlphaDt_ = readSized("dalpha_dt", cells);
   beta_ = readSized("beta", cells);
-  uParticle_ = unflatten(readSized("u_particle", 3 * cells));
-  fExplicit_ = unflatten(readSized("f_explicit", 3 * cells));
+  uParticle_ = unflattenVec3(readSized("u_particle", 3 * cells));
+  fExplicit_ = unflattenVec3(readSized("f_explicit", 3 * cells));
   time_ = file.doubleAttribute(group, "time");
   lastDt_ = file.doubleAttribute(group, "last_dt");
   setFlowFactor(file.doubleAttribute(group, "flow_factor"));
