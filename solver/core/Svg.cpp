@@ -31,7 +31,7 @@ std::string escape(const std::string& s) {
 }
 std::string tickLabel(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", std::abs(v) < 1e-12 ? 0.0 : v);
+  std::snprintf(buf, sizeof buf, "%.3g", std::abs(v) < 1e-12 ? 0.0 : v);
   return buf;
 }
 }  // namespace
