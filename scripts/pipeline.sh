@@ -23,7 +23,8 @@ for _ in $(seq 1 200); do
   sleep 0.05
 done
 export RCFD_SERVER=$(sed -n 's/^listening on //p' "$out/server.out" | head -n1)
-export RCFD_TOKEN=$(cat "$out/data/token")
+# The server takes RCFD_TOKEN when it is set, else it keeps (or creates) one in its data dir.
+export RCFD_TOKEN=${RCFD_TOKEN:-$(cat "$out/data/token")}
 rcfd() { "$bin/rcfd" "$@"; }
 echo "server: $RCFD_SERVER (data in $out/data, log $out/server.log)"
 
