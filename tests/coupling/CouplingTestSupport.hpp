@@ -9,32 +9,21 @@
 #include "cfddem/coupling/DragModel.hpp"
 #include "cfddem/coupling/FluidCoupling.hpp"
 #include "cfddem/gas/GasSolver.hpp"
+#include "../gas/GasTestSupport.hpp"
 
 namespace rcfd::test {
 
 /// A box with its top open (outlet), walls elsewhere, no nozzle air, the effects gas and drag.
 inline Scene couplingBox(const Vec3& size, double cell, double flowRate) {
-  Scene s;
-  s.apparatus.type = ApparatusSpec::Type::Box;
-  s.apparatus.size = size;
-  s.apparatus.box_outlet_top = true;
-  s.grid.cell_size = Vec3(cell, cell, cell);
-  s.process.gas_flow_rate = flowRate;
-  s.process.atomisation_flow_rate = 0.0;
+  Scene s = boxScene(size, Vec3(cell, cell, cell), flowRate);
   s.effects = {"gas", "drag"};
   return s;
 }
 
 /// The quick slice of examples/quick.json (prismatic bed, 0.02 m deep, 5 mm cells, cg 2).
 inline Scene quickSlice() {
-  Scene s;
-  s.apparatus.depth = 0.02;
-  s.grid.cell_size = Vec3(0.005, 0.005, 0.005);
-  s.gas.max_time_step = 5e-5;
-  s.process.gas_flow_rate = 0.0063889;
-  s.process.atomisation_flow_rate = 0.00013889;
+  Scene s = quickSliceScene(false);
   s.process.bed_mass = 0.15;
-  s.spray.nozzle_position = Vec3(0.0, 0.0, 0.01);
   s.dem.coarse_graining = 2.0;
   s.dem.time_step = 1e-5;
   s.effects = {"gas", "drag", "smoothing"};
