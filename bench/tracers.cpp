@@ -16,6 +16,16 @@ nlohmann::json runTracers(const Options& options) {
   const int steps = options.quick ? 5 : 40;
 
   scene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
+  if (const char* e = std::getenv("RCFD_BENCH_INTEGRATOR")) scene.rcfd.integrator = e;
+  if (const char* e = std::getenv("RCFD_BENCH_EFFECTS")) {
+    scene.effects.clear();
+    std::string s(e);
+    for (std::size_t a = 0, b; a < s.size(); a = b + 1) {
+      b = s.find(',', a);
+      if (b == std::string::npos) b = s.size();
+      scene.effects.push_back(s.substr(a, b - a));
+    }
+  }
   const Timing headline = timeRun(scene, db, 1, steps);
   std::cerr << "transport+fluctuation+walls+tracer_volume_fraction: " << headline.tracerStepsPerSecond
             << " tracer-steps/s (" << headline.secondsPerStep * 1e3 << " ms/step, "

@@ -293,6 +293,14 @@ double Apparatus::signedDistance(const Vector3d& p) const {
   return std::min(d2, dz);
 }
 
+std::vector<Apparatus::HalfSpace> Apparatus::convexHalfSpaces() const {
+  std::vector<HalfSpace> out;
+  for (const auto& h : planes_) out.push_back({Vector3d(h.n.x(), h.n.y(), 0.0), h.c});
+  out.push_back({Vector3d(0.0, 0.0, 1.0), 0.0});
+  out.push_back({Vector3d(0.0, 0.0, -1.0), -depth_});
+  return out;
+}
+
 std::optional<BoundaryHit> Apparatus::firstIntersection(const Vector3d& a, const Vector3d& b) const {
   const Vector3d d = b - a;
   if (d.x() == 0.0 && d.y() == 0.0 && d.z() == 0.0) return std::nullopt;

@@ -90,6 +90,17 @@ class Apparatus {
   /// nearestBoundary(). Allocation-free. See the file comment for the tolerance contract.
   std::optional<BoundaryHit> firstIntersection(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
 
+  /// A half-space n . p - c >= 0 bounding the open region.
+  struct HalfSpace {
+    Eigen::Vector3d n;  ///< unit inward normal
+    double c = 0.0;     ///< [m]
+  };
+  /// The half-spaces whose intersection is the open region without the draft plates: one per edge of
+  /// the (convex) outline, then the walls z = 0 and z = depth. A segment whose two ends lie at least
+  /// 2 boundaryTolerance() inside every one of them, and which misses the plates, has no hit in
+  /// firstIntersection(): the vectorised tracer kernel's wall test.
+  std::vector<HalfSpace> convexHalfSpaces() const;
+
   /// Width of the band inside the walls in which firstIntersection() reports hits [m].
   double boundaryTolerance() const { return tol_; }
 

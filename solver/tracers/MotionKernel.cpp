@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "core/Errors.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FluctuationModel.hpp"
+#include "tracers/BlockSampling.hpp"
 #include "tracers/UnitVectors.hpp"
 
 namespace rcfd {
@@ -46,6 +48,26 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
       // The factor 1 - 1e-6 covers the rounding to float (6e-8) and of the distances.
       clearance_[std::size_t(c)] = float(std::max(0.0, sd - halfDiagonal) * (1.0 - 1e-6));
       reach_[std::size_t(c)] = float(std::max(0.0, sd - band) * (1.0 - 1e-6));
+    }
+    halfSpaces_ = apparatus_.convexHalfSpaces();
+    // Distance from each cell centre to the draft plates less the band: a move with
+    // |p - centre| + |disp| below it cannot reach a plate (the block path's second wall test).
+    const auto& holes = apparatus_.holes();
+    if (!holes.empty()) {
+      plateReach_.resize(std::size_t(grid_.cellCount()));
+#pragma omp parallel for schedule(static) if (grid_.cellCount() > kParallelThreshold)
+      for (std::int64_t c = 0; c < grid_.cellCount(); ++c) {
+        const auto ijk = grid_.cellIjk(c);
+        const Eigen::Vector3d centre = grid_.cellCenter(ijk[0], ijk[1], ijk[2]);
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const auto& hole : holes) {
+          Eigen::Vector2d lo = hole.front(), hi = hole.front();
+          for (const auto& v : hole) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+          const Eigen::Vector2d q = centre.head<2>().cwiseMax(lo).cwiseMin(hi);  // nearest point of the plate
+          nearest = std::min(nearest, (centre.head<2>() - q).norm());
+        }
+        plateReach_[std::size_t(c)] = float(std::max(0.0, nearest - band) * (1.0 - 1e-6));
+      }
     }
   }
 }
@@ -129,50 +151,153 @@ class CornerCache {
   Eigen::Array4d corners_[8];
 };
 
-/// Tracers processed together: the common case (one sub-step, no wall within reach, no free flight)
-/// runs through loops over a block that the compiler vectorises; the rest takes the scalar path. Blocks
-/// start at multiples of kBlock whatever the thread count, so each tracer takes the same path in the
-/// same lane, and results stay bit-identical for any number of threads.
-constexpr int kBlock = 64;
+}  // namespace
 
-/// u at the points (x, y, z) of a block: trilinear in a step field of 4 floats per cell, plus (ax, ay, az).
-void sampleBlock(const TrilinearLocator& locator, const float* field, int count, const double* x,
-                 const double* y, const double* z, const double* ax, const double* ay, const double* az,
-                 double* ux, double* uy, double* uz) {
-  // Plain locals only: the vectoriser gives up on loads through `this` and on per-lane arrays.
-  const TrilinearLocator::Constants q = locator.constants();
-  const double ox = q.ox, oy = q.oy, oz = q.oz, ix = q.ix, iy = q.iy, iz = q.iz;
-  const double lastX = q.lastX, lastY = q.lastY, lastZ = q.lastZ;
-  const int maxX = q.maxX, maxY = q.maxY, maxZ = q.maxZ;
-  const std::int32_t sy = q.sy, sz = q.sz;
-  std::int32_t off[8];
-  for (int c = 0; c < 8; ++c) off[c] = 4 * locator.offsets32()[c];
+namespace block {
+/// Tracer lanes of a block that move along u_P^rec (not in free flight), in one sub-step round: views
+/// of the cloud's arrays (the common case, no copies) or of a LaneStorage (compacted lanes).
+struct Lanes {
+  double *x, *y, *z;         ///< position [m]
+  const double *ax, *ay, *az;  ///< u_fluc of Eq. (10) [m/s]
+  double *ux, *uy, *uz;      ///< velocity of the sub-step [m/s]
+  double* h;                 ///< sub-step [s]
+  std::int32_t* left;        ///< sub-steps still to take after this round
+  int count = 0;
+};
+
+/// Storage of compacted lanes.
+struct LaneStorage {
+  alignas(64) double x[kBlock], y[kBlock], z[kBlock];
+  alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];
+  alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];
+  alignas(64) double h[kBlock];
+  alignas(64) std::int32_t left[kBlock];
+  std::int32_t lane[kBlock];  ///< the lane's index in the lanes it was compacted from
+  Lanes view(int count) { return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count}; }
+};
+
+/// What every sub-step round of a move() reads: the step field, the grid and the walls as plain values.
+struct Context {
+  const float* field = nullptr;     ///< u_P^rec of the step, 4 floats per cell
+  const float* cellData = nullptr;  ///< MotionKernel::cellData_
+  const float* plateReach = nullptr;  ///< per cell, or null without draft plates
+  TrilinearLocator::Constants q{};
+  std::int32_t corner4[8] = {};     ///< corner offsets in floats of the step field
+  double origin[3] = {}, inv[3] = {}, spacing[3] = {};
+  int last[3] = {};
+  std::int32_t sy = 0, sz = 0;
+  static constexpr int kMaxHalfSpaces = 16;
+  int halfSpaces = 0;               ///< 0: no half-space test (walls off, or an outline too complex)
+  double hx[kMaxHalfSpaces] = {}, hy[kMaxHalfSpaces] = {}, hz[kMaxHalfSpaces] = {}, hc[kMaxHalfSpaces] = {};
+  double margin = 0.0;              ///< 2 boundaryTolerance() [m]
+  double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
+  bool midpoint = true;
+  bool walls = true;
+};
+}  // namespace block
+
+void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sampled, const block::Context& bc,
+                           MotionStatistics& st) const {
+  using namespace block;
+  const int m = L.count;
+  if (!sampled) {  // Eq. (9): u_P^rec at the sub-step's start
+    locateBlock(bc.q, m, L.x, L.y, L.z, s, nullptr);
+    gatherBlock(bc.field, bc.corner4, m, s);
+    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+  }
+  if (bc.midpoint) {
+    // Midpoint rule (see moveOne); its stencil reuses the start's corners where it is the same.
+    alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];
+    alignas(64) std::int32_t midBase[kBlock];
 #pragma omp simd
-  for (int k = 0; k < count; ++k) {
-    int lx, ly, lz;
-    const double fx = TrilinearLocator::Constants::axis(x[k], ox, ix, lastX, maxX, lx);
-    const double fy = TrilinearLocator::Constants::axis(y[k], oy, iy, lastY, maxY, ly);
-    const double fz = TrilinearLocator::Constants::axis(z[k], oz, iz, lastZ, maxZ, lz);
-    const float* c = field + 4 * (lx + ly * sy + lz * sz);
-    // trilinear() of Trilinear.hpp written out on the corner loads (x, then y, then z).
-    auto lerp = [&](int d) {
-      const double x00 = c[off[0] + d] + fx * (double(c[off[1] + d]) - c[off[0] + d]);
-      const double x10 = c[off[2] + d] + fx * (double(c[off[3] + d]) - c[off[2] + d]);
-      const double x01 = c[off[4] + d] + fx * (double(c[off[5] + d]) - c[off[4] + d]);
-      const double x11 = c[off[6] + d] + fx * (double(c[off[7] + d]) - c[off[6] + d]);
-      const double y0 = x00 + fy * (x10 - x00);
-      const double y1 = x01 + fy * (x11 - x01);
-      return y0 + fz * (y1 - y0);
-    };
-    ux[k] = lerp(0) + ax[k];
-    uy[k] = lerp(1) + ay[k];
-    uz[k] = lerp(2) + az[k];
+    for (int k = 0; k < m; ++k) {
+      const double half = 0.5 * L.h[k];
+      mx[k] = L.x[k] + half * L.ux[k], my[k] = L.y[k] + half * L.uy[k], mz[k] = L.z[k] + half * L.uz[k];
+    }
+    locateBlock(bc.q, m, mx, my, mz, s, midBase);
+    regatherChanged(bc.field, bc.corner4, m, midBase, s);
+    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+  }
+  // Plain local pointers: the vectoriser does not look through the view's members.
+  double* const x = L.x;
+  double* const y = L.y;
+  double* const z = L.z;
+  const double* const ux = L.ux;
+  const double* const uy = L.uy;
+  const double* const uz = L.uz;
+  const double* const h = L.h;
+  // Walls, first test: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move
+  // inside (signed distances are 1-Lipschitz).
+  alignas(64) std::int64_t fast[kBlock];
+  alignas(64) double ex[kBlock], ey[kBlock], ez[kBlock];  // end points
+  alignas(64) double off[kBlock], length[kBlock];
+  alignas(64) std::int32_t cell[kBlock];
+  const float* cellData = bc.cellData;
+  const double noWall = bc.noWall;
+  std::int64_t pending = 0;
+#pragma omp simd reduction(+ : pending)
+  for (int k = 0; k < m; ++k) {
+    const double dx = h[k] * ux[k], dy = h[k] * uy[k], dz = h[k] * uz[k];
+    ex[k] = x[k] + dx, ey[k] = y[k] + dy, ez[k] = z[k] + dz;
+    length[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
+    int ci[3];
+    double off2 = 0.0;
+    const double pk[3] = {x[k], y[k], z[k]};
+    for (int d = 0; d < 3; ++d) {
+      const double t = (pk[d] - bc.origin[d]) * bc.inv[d];
+      const int i = int(t > 0.0 ? t : 0.0);
+      ci[d] = i < bc.last[d] ? i : bc.last[d];
+      const double e = pk[d] - (bc.origin[d] + (double(ci[d]) + 0.5) * bc.spacing[d]);
+      off2 += e * e;
+    }
+    off[k] = std::sqrt(off2);
+    cell[k] = ci[0] + ci[1] * bc.sy + ci[2] * bc.sz;
+    const double reach = double(cellData[2 * cell[k]]) + noWall;
+    fast[k] = off[k] + length[k] < reach;
+    pending += 1 - fast[k];
+  }
+  // Second test, for moves near a wall: both ends at least `margin` inside every half-space of the
+  // outline and the z walls (firstIntersection() then reports no wall hit) and the whole move farther
+  // than the hit band from the draft plates.
+  if (pending > 0 && bc.halfSpaces > 0) {
+    const double margin = bc.margin;
+    const float* plateReach = bc.plateReach;
+    alignas(64) std::int64_t inside[kBlock];
+    if (plateReach) {
+#pragma omp simd
+      for (int k = 0; k < m; ++k) inside[k] = off[k] + length[k] < double(plateReach[cell[k]]);
+    } else {
+      for (int k = 0; k < m; ++k) inside[k] = 1;
+    }
+    for (int j = 0; j < bc.halfSpaces; ++j) {
+      const double nx = bc.hx[j], ny = bc.hy[j], nz = bc.hz[j], c = bc.hc[j];
+#pragma omp simd
+      for (int k = 0; k < m; ++k) {
+        const double ga = nx * x[k] + ny * y[k] + nz * z[k] - c;
+        const double gb = nx * ex[k] + ny * ey[k] + nz * ez[k] - c;
+        inside[k] &= std::int64_t(ga >= margin) & std::int64_t(gb >= margin);
+      }
+    }
+#pragma omp simd
+    for (int k = 0; k < m; ++k) fast[k] |= inside[k];
+  }
+#pragma omp simd
+  for (int k = 0; k < m; ++k) {
+    if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];  // masked stores
+  }
+  // The rest meet a wall or pass close to one: the exact segment test and mirror reflection.
+  for (int k = 0; k < m; ++k) {
+    if (fast[k]) continue;
+    Eigen::Vector3d p(x[k], y[k], z[k]);
+    const Eigen::Vector3d u(ux[k], uy[k], uz[k]);
+    st.wallHits += moveWithWalls(p, h[k] * u, nullptr, 1.0);
+    ++st.exactWallTests;
+    x[k] = p.x(), y[k] = p.y(), z[k] = p.z();
   }
 }
 
-}  // namespace
-
 void MotionKernel::move(TracerContext& ctx) {
+  using namespace block;
   stats_ = {};
   if (!settings_.transport) return;
   TracerCloud& cloud = ctx.cloud;
@@ -196,24 +321,33 @@ void MotionKernel::move(TracerContext& ctx) {
     }
     return std::max(1, int(std::ceil(courant)));
   };
-  const float* field = particleVelocity_.floats();
-  const float* cellData = cellData_.data();
-  const double noWall = settings_.walls ? 0.0 : 1e300;  // without walls every move is within reach
-  struct {
-    double origin[3], inv[3], spacing[3];
-    int last[3];
-    std::int32_t sy, sz;
-  } g{};
-  for (int d = 0; d < 3; ++d) {
-    g.origin[d] = grid_.origin[d], g.inv[d] = 1.0 / grid_.spacing[d], g.spacing[d] = grid_.spacing[d];
-    g.last[d] = grid_.shape[d] - 1;
-  }
-  g.sy = grid_.shape[0], g.sz = grid_.shape[0] * grid_.shape[1];
-  const bool midpoint = settings_.midpoint;
   const bool walls = settings_.walls;
-  const std::int64_t vectorised = settings_.vectorised ? 1 : 0;
+  const bool midpoint = settings_.midpoint;
 
-  // The scalar path: sub-steps, walls within reach, free flight.
+  Context bc;
+  bc.field = particleVelocity_.floats();
+  bc.cellData = cellData_.data();
+  bc.plateReach = plateReach_.empty() ? nullptr : plateReach_.data();
+  bc.q = locator.constants();
+  for (int c = 0; c < 8; ++c) bc.corner4[c] = 4 * locator.offsets32()[c];
+  for (int d = 0; d < 3; ++d) {
+    bc.origin[d] = grid_.origin[d], bc.inv[d] = 1.0 / grid_.spacing[d], bc.spacing[d] = grid_.spacing[d];
+    bc.last[d] = grid_.shape[d] - 1;
+  }
+  bc.sy = grid_.shape[0], bc.sz = grid_.shape[0] * grid_.shape[1];
+  bc.noWall = walls ? 0.0 : 1e300;
+  bc.midpoint = midpoint;
+  bc.walls = walls;
+  if (walls && halfSpaces_.size() <= std::size_t(Context::kMaxHalfSpaces)) {
+    bc.halfSpaces = int(halfSpaces_.size());
+    for (int j = 0; j < bc.halfSpaces; ++j) {
+      const auto& hs = halfSpaces_[std::size_t(j)];
+      bc.hx[j] = hs.n.x(), bc.hy[j] = hs.n.y(), bc.hz[j] = hs.n.z(), bc.hc[j] = hs.c;
+    }
+    bc.margin = 2.0 * apparatus_.boundaryTolerance();
+  }
+
+  // The scalar path: free flight, and every tracer when the block path is off (tests compare both).
   // Counters go through `st`, not captured: a capture would bypass the OpenMP reduction's copies.
   auto moveOne = [&](std::int64_t i, std::int64_t cell, const Eigen::Vector3d& fluc, MotionStatistics& st) {
     Eigen::Vector3d p = cloud.position(std::size_t(i));
@@ -257,33 +391,39 @@ void MotionKernel::move(TracerContext& ctx) {
   double* const px = cloud.x.data();
   double* const py = cloud.y.data();
   double* const pz = cloud.z.data();
+  double* const pvx = cloud.vx.data();
+  double* const pvy = cloud.vy.data();
+  double* const pvz = cloud.vz.data();
+  const float* cellData = cellData_.data();
+  const bool vectorised = settings_.vectorised;
 #pragma omp parallel for schedule(static) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests) if (n > kParallelThreshold)
   for (std::int64_t b = 0; b < blocks; ++b) {
     const std::int64_t i0 = b * kBlock;
     const int count = int(std::min<std::int64_t>(kBlock, n - i0));
     MotionStatistics st;
     alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
-    alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];  // u at the start (then at the midpoint)
-    alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];  // midpoint
     alignas(64) double speed[kBlock];
-    std::int32_t cellOf[kBlock];
-    // Flags (not bool, which stops the vectoriser): free flight; one sub-step; move final here.
-    std::int64_t scalar[kBlock], single[kBlock], fast[kBlock];
-    // Cells, then their clearance and Eq. (10) speed: independent loads the vectorised loop issues as
-    // gathers, so their cache misses overlap.
+    alignas(64) std::int32_t cellOf[kBlock];
+    std::int64_t free[kBlock];  // free flight (not bool, which stops the vectoriser)
+    // Cells, then their Eq. (10) speed: independent loads the vectorised loop issues as gathers, so
+    // their cache misses overlap.
     if (haveTracerAlpha) {
       for (int k = 0; k < count; ++k) cellOf[k] = ctx.tracerCell[std::size_t(i0 + k)];
     } else {
       for (int k = 0; k < count; ++k) cellOf[k] = std::int32_t(grid_.flatIndexOf(cloud.position(std::size_t(i0 + k))));
     }
+    std::int64_t freeLanes = 0;
     if (settings_.freeFlight) {
-      for (int k = 0; k < count; ++k) scalar[k] = sampler.alphaP(cellOf[k]) < settings_.freeFlightAlpha;
+      for (int k = 0; k < count; ++k) {
+        free[k] = sampler.alphaP(cellOf[k]) < settings_.freeFlightAlpha;
+        freeLanes += free[k];
+      }
     } else {
-      for (int k = 0; k < count; ++k) scalar[k] = 0;
+      for (int k = 0; k < count; ++k) free[k] = 0;
     }
 #pragma omp simd
     for (int k = 0; k < count; ++k) {
-      speed[k] = double(cellData[2 * cellOf[k] + 1]) * double(1 - scalar[k]);  // none in free flight
+      speed[k] = double(cellData[2 * cellOf[k] + 1]) * double(1 - free[k]);  // none in free flight
     }
     // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
     if (fluctuate) {
@@ -296,71 +436,82 @@ void MotionKernel::move(TracerContext& ctx) {
     } else {
       for (int k = 0; k < count; ++k) ax[k] = ay[k] = az[k] = 0.0;
     }
-    const double* x = px + i0;
-    const double* y = py + i0;
-    const double* z = pz + i0;
-    sampleBlock(locator, field, count, x, y, z, ax, ay, az, ux, uy, uz);  // Eq. (9)
-    if (midpoint) {
-      const double half = 0.5 * dt;
-#pragma omp simd
+    if (!vectorised) {
       for (int k = 0; k < count; ++k) {
-        mx[k] = x[k] + half * ux[k], my[k] = y[k] + half * uy[k], mz[k] = z[k] + half * uz[k];
-      }
-    }
-    // One sub-step (|u| dt <= max_courant cells; the test of substepsFor) and a displacement shorter
-    // than the cell's wall clearance: the move is final here.
-    const double limit2 = cellLimit * cellLimit;
-#pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      const double d2 = (ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * (dt * dt);
-      single[k] = (!scalar[k]) & (d2 <= limit2) & vectorised;
-    }
-    if (midpoint) sampleBlock(locator, field, count, mx, my, mz, ax, ay, az, ux, uy, uz);
-    // Walls: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move inside.
-#pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      const double dx = dt * ux[k], dy = dt * uy[k], dz = dt * uz[k];
-      const double length = std::sqrt(dx * dx + dy * dy + dz * dz);
-      int ci[3];
-      double off2 = 0.0;
-      const double pk[3] = {x[k], y[k], z[k]};
-      for (int d = 0; d < 3; ++d) {
-        const double t = (pk[d] - g.origin[d]) * g.inv[d];
-        const int i = int(t > 0.0 ? t : 0.0);
-        ci[d] = i < g.last[d] ? i : g.last[d];
-        const double e = pk[d] - (g.origin[d] + (double(ci[d]) + 0.5) * g.spacing[d]);
-        off2 += e * e;
-      }
-      const double reach = double(cellData[2 * (ci[0] + ci[1] * g.sy + ci[2] * g.sz)]) + noWall;
-      fast[k] = single[k] & (std::sqrt(off2) + length < reach);
-    }
-    double* const bx = px + i0;
-    double* const by = py + i0;
-    double* const bz = pz + i0;
-    double* const bvx = cloud.vx.data() + i0;
-    double* const bvy = cloud.vy.data() + i0;
-    double* const bvz = cloud.vz.data() + i0;
-#pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      if (fast[k]) {  // masked stores
-        bx[k] += dt * ux[k], by[k] += dt * uy[k], bz[k] += dt * uz[k];
-        bvx[k] = ux[k], bvy[k] = uy[k], bvz[k] = uz[k];
-      }
-    }
-    for (int k = 0; k < count; ++k) {
-      if (fast[k]) continue;
-      const std::int64_t i = i0 + k;
-      if (single[k]) {
-        // One sub-step with a wall within reach: the block's (midpoint) velocity, the exact wall test.
-        Eigen::Vector3d p = cloud.position(std::size_t(i));
-        const Eigen::Vector3d u(ux[k], uy[k], uz[k]);
-        st.wallHits += moveWithWalls(p, dt * u, nullptr, 1.0, walls ? double(clearance_[std::size_t(cellOf[k])]) : -1.0);
-        ++st.exactWallTests;
-        cloud.setPosition(std::size_t(i), p);
-        cloud.setVelocity(std::size_t(i), u);
-      } else {
-        moveOne(i, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+        moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
         ++st.scalarPath;
+      }
+    } else {
+      // The lanes that follow u_P^rec: all of them, in place in the cloud's arrays (the velocity arrays
+      // hold u as it is computed), unless some are in free flight.
+      alignas(64) double h[kBlock];
+      alignas(64) std::int32_t left[kBlock];
+      LaneStorage compact;
+      Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, pvx + i0, pvy + i0, pvz + i0, h, left, count};
+      if (freeLanes > 0) {
+        int j = 0;
+        for (int k = 0; k < count; ++k) {
+          if (free[k]) continue;
+          compact.x[j] = px[i0 + k], compact.y[j] = py[i0 + k], compact.z[j] = pz[i0 + k];
+          compact.ax[j] = ax[k], compact.ay[j] = ay[k], compact.az[j] = az[k];
+          compact.lane[j++] = k;
+        }
+        L = compact.view(j);
+      }
+      const int m = L.count;
+      // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
+      BlockStencils stencils;
+      locateBlock(bc.q, m, L.x, L.y, L.z, stencils, nullptr);
+      gatherBlock(bc.field, bc.corner4, m, stencils);
+      interpolateBlock(stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+      std::int64_t extra = 0, cappedHere = 0;
+      std::int32_t maxLeft = 0;
+#pragma omp simd reduction(+ : extra, cappedHere) reduction(max : maxLeft)
+      for (int k = 0; k < m; ++k) {
+        const double distance = std::sqrt(L.ux[k] * L.ux[k] + L.uy[k] * L.uy[k] + L.uz[k] * L.uz[k]) * dt;
+        const double courant = distance / cellLimit;
+        const std::int64_t over = !(courant <= double(kMaxSubsteps));
+        const double c = over ? double(kMaxSubsteps) : courant;
+        const double rounded = std::ceil(c);
+        const int nsub = rounded > 1.0 ? int(rounded) : 1;
+        L.h[k] = dt / double(nsub);
+        L.left[k] = nsub - 1;
+        extra += nsub - 1, cappedHere += over;
+        maxLeft = L.left[k] > maxLeft ? L.left[k] : maxLeft;
+      }
+      st.substeps += extra, st.substepCapped += cappedHere;
+      subStep(L, stencils, true, bc, st);
+      // Further sub-steps (fast tracers, mostly in the spout): the lanes that still have some, compacted.
+      for (std::int32_t round = 1; round <= maxLeft; ++round) {
+        LaneStorage rs;
+        int r = 0;
+        for (int k = 0; k < m; ++k) {
+          if (L.left[k] <= 0) continue;
+          rs.x[r] = L.x[k], rs.y[r] = L.y[k], rs.z[r] = L.z[k];
+          rs.ax[r] = L.ax[k], rs.ay[r] = L.ay[k], rs.az[r] = L.az[k];
+          rs.h[r] = L.h[k];
+          rs.lane[r++] = k;
+          --L.left[k];
+        }
+        Lanes R = rs.view(r);
+        subStep(R, stencils, false, bc, st);
+        for (int j = 0; j < r; ++j) {
+          const int k = rs.lane[j];
+          L.x[k] = R.x[j], L.y[k] = R.y[j], L.z[k] = R.z[j];
+          L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
+        }
+      }
+      if (freeLanes > 0) {
+        for (int j = 0; j < m; ++j) {
+          const std::int64_t i = i0 + compact.lane[j];
+          px[i] = L.x[j], py[i] = L.y[j], pz[i] = L.z[j];
+          pvx[i] = L.ux[j], pvy[i] = L.uy[j], pvz[i] = L.uz[j];
+        }
+        for (int k = 0; k < count; ++k) {
+          if (!free[k]) continue;
+          moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+          ++st.scalarPath;
+        }
       }
     }
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;

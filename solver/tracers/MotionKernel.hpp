@@ -9,10 +9,16 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/Apparatus.hpp"
 #include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
+namespace block {
+struct BlockStencils;
+struct Context;
+struct Lanes;
+}  // namespace block
 
 /// Counters of the last step (for diagnostics and tests).
 struct MotionStatistics {
@@ -20,8 +26,8 @@ struct MotionStatistics {
   std::int64_t wallHits = 0;        ///< reflections
   std::int64_t freeFlight = 0;      ///< tracers in free flight
   std::int64_t substepCapped = 0;   ///< tracers that needed more than kMaxSubsteps
-  std::int64_t scalarPath = 0;      ///< tracers moved one by one (sub-steps, free flight)
-  std::int64_t exactWallTests = 0;  ///< block-path tracers with a wall within reach (exact segment test)
+  std::int64_t scalarPath = 0;      ///< tracers moved one by one (free flight, or the block path off)
+  std::int64_t exactWallTests = 0;  ///< block-path sub-steps that needed the exact segment test
 };
 
 class MotionKernel {
@@ -44,12 +50,18 @@ class MotionKernel {
  private:
   /// Builds the step's velocity fields and cell table from the context's frames and tracer alpha_P.
   void prepare(const TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
+  /// One sub-step of a block's lanes along u_P^rec (sampled at the start already when `sampled`):
+  /// midpoint, the vectorised wall tests, then the exact segment test for the moves they do not clear.
+  void subStep(block::Lanes& lanes, block::BlockStencils& stencils, bool sampled, const block::Context& bc,
+               MotionStatistics& st) const;
 
   MotionSettings settings_;
   const Apparatus& apparatus_;
   const CartesianGrid& grid_;
   std::vector<float> clearance_;  ///< lower bound of the wall distance from any point of each cell [m]
   std::vector<float> reach_;      ///< wall distance of each cell centre less the hit band [m]
+  std::vector<float> plateReach_; ///< draft-plate distance of each cell centre less the band [m] (plates only)
+  std::vector<Apparatus::HalfSpace> halfSpaces_;  ///< the open region's convex part
   double minSpacing_;
   double stokesTime_;             ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
   double particleDiameter_;
