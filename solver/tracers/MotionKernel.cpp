@@ -151,6 +151,28 @@ class CornerCache {
   Eigen::Array4d corners_[8];
 };
 
+/// Sub-steps of the lanes of a block so that none moves farther than `limit` (max_courant cells) at
+/// its start velocity u: the arithmetic of substepsFor() in move(). `over` marks lanes capped at
+/// kMaxSubsteps (also a non-finite u).
+void substepsOfBlock(const double* ux, const double* uy, const double* uz, int count, double dt, double limit,
+                     double* h, std::int32_t* left, std::int32_t* over) {
+  constexpr double kMax = MotionKernel::kMaxSubsteps;
+#pragma omp simd
+  for (int k = 0; k < count; ++k) {
+    const double distance = std::sqrt(ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * dt;
+    const double courant = distance / limit;
+    const bool within = courant <= kMax;  // false also for NaN
+    const double c = within ? courant : kMax;
+    // ceil(c) from rint (round to nearest): GCC 12 vectorises rint but not ceil without -fno-trapping-math.
+    const double nearest = std::rint(c);
+    const double rounded = nearest < c ? nearest + 1.0 : nearest;
+    const double nsub = rounded > 1.0 ? rounded : 1.0;
+    h[k] = dt / nsub;
+    left[k] = std::int32_t(nsub) - 1;
+    over[k] = within ? 0 : 1;
+  }
+}
+
 }  // namespace
 
 namespace block {
@@ -466,18 +488,11 @@ void MotionKernel::move(TracerContext& ctx) {
       interpolateBlock(stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
       std::int64_t extra = 0, cappedHere = 0;
       std::int32_t maxLeft = 0;
-#pragma omp simd reduction(+ : extra, cappedHere) reduction(max : maxLeft)
+      alignas(64) std::int32_t over[kBlock];
+      substepsOfBlock(L.ux, L.uy, L.uz, m, dt, cellLimit, L.h, L.left, over);
       for (int k = 0; k < m; ++k) {
-        const double distance = std::sqrt(L.ux[k] * L.ux[k] + L.uy[k] * L.uy[k] + L.uz[k] * L.uz[k]) * dt;
-        const double courant = distance / cellLimit;
-        const std::int64_t over = !(courant <= double(kMaxSubsteps));
-        const double c = over ? double(kMaxSubsteps) : courant;
-        const double rounded = std::ceil(c);
-        const int nsub = rounded > 1.0 ? int(rounded) : 1;
-        L.h[k] = dt / double(nsub);
-        L.left[k] = nsub - 1;
-        extra += nsub - 1, cappedHere += over;
-        maxLeft = L.left[k] > maxLeft ? L.left[k] : maxLeft;
+        extra += L.left[k], cappedHere += over[k];
+        maxLeft = std::max(maxLeft, L.left[k]);
       }
       st.substeps += extra, st.substepCapped += cappedHere;
       subStep(L, stencils, true, bc, st);
