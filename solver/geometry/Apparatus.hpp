@@ -96,9 +96,10 @@ class Apparatus {
     double c = 0.0;     ///< [m]
   };
   /// The half-spaces whose intersection is the open region without the draft plates: one per edge of
-  /// the (convex) outline, then the walls z = 0 and z = depth. A segment whose two ends lie at least
-  /// 2 boundaryTolerance() inside every one of them, and which misses the plates, has no hit in
-  /// firstIntersection(): the vectorised tracer kernel's wall test.
+  /// the (convex) outline, then the walls z = 0 and z = depth. A segment from an admissible start
+  /// (see firstIntersection()) whose end lies at least 2 boundaryTolerance() inside every one of them,
+  /// and which misses the plates, has no hit in firstIntersection(): the vectorised tracer kernel's
+  /// wall test.
   std::vector<HalfSpace> convexHalfSpaces() const;
 
   /// Width of the band inside the walls in which firstIntersection() reports hits [m].

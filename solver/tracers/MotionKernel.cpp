@@ -278,9 +278,10 @@ void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sample
     fast[k] = off[k] + length[k] < reach;
     pending += 1 - fast[k];
   }
-  // Second test, for moves near a wall: both ends at least `margin` inside every half-space of the
-  // outline and the z walls (firstIntersection() then reports no wall hit) and the whole move farther
-  // than the hit band from the draft plates.
+  // Second test, for moves near a wall: the end at least `margin` inside every half-space of the
+  // outline and the z walls, and the whole move farther than the hit band from the draft plates. Then
+  // firstIntersection() reports no hit: from a start clear of a wall's band both ends are clear, and
+  // from a start inside the band the move goes inwards, which is not a hit either.
   if (pending > 0 && bc.halfSpaces > 0) {
     const double margin = bc.margin;
     const float* plateReach = bc.plateReach;
@@ -294,11 +295,7 @@ void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sample
     for (int j = 0; j < bc.halfSpaces; ++j) {
       const double nx = bc.hx[j], ny = bc.hy[j], nz = bc.hz[j], c = bc.hc[j];
 #pragma omp simd
-      for (int k = 0; k < m; ++k) {
-        const double ga = nx * x[k] + ny * y[k] + nz * z[k] - c;
-        const double gb = nx * ex[k] + ny * ey[k] + nz * ez[k] - c;
-        inside[k] &= std::int64_t(ga >= margin) & std::int64_t(gb >= margin);
-      }
+      for (int k = 0; k < m; ++k) inside[k] &= std::int64_t(nx * ex[k] + ny * ey[k] + nz * ez[k] - c >= margin);
     }
 #pragma omp simd
     for (int k = 0; k < m; ++k) fast[k] |= inside[k];
