@@ -19,7 +19,9 @@ constexpr int kBlock = 64;
 /// lane-major, so the interpolation reads corners with plain vector loads and a second point in the
 /// same stencil (a midpoint, mostly) reuses them without another gather.
 struct BlockStencils {
-  alignas(64) float corner[24][kBlock];  ///< [3 c + d][k]: component d of corner c of lane k
+  /// [3 c + d][k]: component d of corner c of lane k, converted to double once when gathered (a
+  /// midpoint in the same stencil interpolates without converting again)
+  alignas(64) double corner[24][kBlock];
   alignas(64) double fx[kBlock], fy[kBlock], fz[kBlock];
   alignas(64) std::int32_t base[kBlock];
 };
@@ -82,7 +84,7 @@ void interpolateBlock(const BlockStencils& s, int count, const double* ax, const
   for (int k = 0; k < count; ++k) {
     const double fx = s.fx[k], fy = s.fy[k], fz = s.fz[k];
     auto lerp = [&](int d) {
-      auto at = [&](int c) { return double(s.corner[3 * c + d][k]); };
+      auto at = [&](int c) { return s.corner[3 * c + d][k]; };
       const double x00 = at(0) + fx * (at(1) - at(0));
       const double x10 = at(2) + fx * (at(3) - at(2));
       const double x01 = at(4) + fx * (at(5) - at(4));
