@@ -50,10 +50,12 @@ class CounterRng {
   std::uint64_t nextU64() { return mix64(key_ + 0x9e3779b97f4a7c15ULL * (++counter_)); }
   /// Uniform in [0, 1) with 53 random bits.
   double uniform() { return double(nextU64() >> 11) * 0x1.0p-53; }
-  /// Uniform random unit vector (uniform on the sphere).
+  /// Uniform random unit vector (uniform on the sphere): z and the azimuth from the upper and lower
+  /// 32 bits of one draw (a resolution of 2^-32 in both, far below anything a direction is used for).
   Eigen::Vector3d unitVector() {
-    const double z = 2.0 * uniform() - 1.0;
-    const double phi = 2.0 * std::numbers::pi * uniform();
+    const std::uint64_t draw = nextU64();
+    const double z = 2.0 * (double(std::uint32_t(draw >> 32)) * 0x1.0p-32) - 1.0;
+    const double phi = 2.0 * std::numbers::pi * (double(std::uint32_t(draw)) * 0x1.0p-32);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     return {r * std::cos(phi), r * std::sin(phi), z};
   }

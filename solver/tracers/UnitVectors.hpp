@@ -37,13 +37,14 @@ inline void sinCosTwoPi(double u, double& s, double& c) {
   c = ((q + 1) & 2) ? -ca : ca;
 }
 
-/// The unit vector CounterRng(prefix, stream).unitVector() draws (z, then the azimuth), with
-/// sinCosTwoPi for the azimuth.
+/// The unit vector CounterRng(prefix, stream).unitVector() draws (z and the azimuth from one 64-bit
+/// draw), with sinCosTwoPi for the azimuth.
 inline void counterUnitVector(const CounterRngPrefix& prefix, std::uint64_t stream, double& x, double& y, double& z) {
   const std::uint64_t key = mix64(prefix.head + stream) ^ prefix.tail;
-  // nextU64() of draws 1 and 2; values below 2^53 convert exactly through int64.
-  const double u1 = double(std::int64_t(mix64(key + 0x9e3779b97f4a7c15ULL * 1) >> 11)) * 0x1.0p-53;
-  const double u2 = double(std::int64_t(mix64(key + 0x9e3779b97f4a7c15ULL * 2) >> 11)) * 0x1.0p-53;
+  // nextU64() of draw 1, split into its upper and lower 32 bits; they convert exactly through int64.
+  const std::uint64_t draw = mix64(key + 0x9e3779b97f4a7c15ULL);
+  const double u1 = double(std::int64_t(draw >> 32)) * 0x1.0p-32;
+  const double u2 = double(std::int64_t(draw & 0xffffffffULL)) * 0x1.0p-32;
   z = 2.0 * u1 - 1.0;
   const double r2 = 1.0 - z * z;
   const double r = std::sqrt(r2 > 0.0 ? r2 : 0.0);
