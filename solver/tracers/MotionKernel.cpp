@@ -415,7 +415,10 @@ void MotionKernel::move(TracerContext& ctx) {
   double* const pvz = cloud.vz.data();
   const float* cellData = cellData_.data();
   const bool vectorised = settings_.vectorised;
-#pragma omp parallel for schedule(static) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests) if (n > kParallelThreshold)
+  // Dynamic chunks of blocks: sub-stepped and near-wall tracers cluster (in the spout, at the walls), so
+  // equal shares of blocks are not equal work. The blocks themselves, and integer counters, keep the
+  // results independent of which thread moves which block.
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests) if (n > kParallelThreshold)
   for (std::int64_t b = 0; b < blocks; ++b) {
     const std::int64_t i0 = b * kBlock;
     const int count = int(std::min<std::int64_t>(kBlock, n - i0));
