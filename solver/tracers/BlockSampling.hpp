@@ -28,7 +28,7 @@ struct BlockStencils {
 
 /// Base indices and fractions of the points (x, y, z) of a block, into `s`, or the base indices into
 /// `newBase` (for regatherChanged) when it is given.
-void locateBlock(const TrilinearLocator::Constants& q, int count, const double* x, const double* y,
+inline void locateBlock(const TrilinearLocator::Constants& q, int count, const double* x, const double* y,
                  const double* z, BlockStencils& s, std::int32_t* newBase) {
   // Plain locals only: the vectoriser gives up on loads through `this` and on per-lane arrays.
   const double ox = q.ox, oy = q.oy, oz = q.oz, ix = q.ix, iy = q.iy, iz = q.iz;
@@ -47,7 +47,7 @@ void locateBlock(const TrilinearLocator::Constants& q, int count, const double* 
 }
 
 /// The corners of every lane's stencil from a step field of 4 floats per cell (vector gathers).
-void gatherBlock(const float* field, const std::int32_t* off, int count, BlockStencils& s) {
+inline void gatherBlock(const float* field, const std::int32_t* off, int count, BlockStencils& s) {
   const std::int32_t o0 = off[0], o1 = off[1], o2 = off[2], o3 = off[3];
   const std::int32_t o4 = off[4], o5 = off[5], o6 = off[6], o7 = off[7];
 #pragma omp simd
@@ -63,7 +63,7 @@ void gatherBlock(const float* field, const std::int32_t* off, int count, BlockSt
 }
 
 /// Re-gathers, one lane at a time, only the lanes whose stencil base changed to `newBase`.
-void regatherChanged(const float* field, const std::int32_t* off, int count, const std::int32_t* newBase,
+inline void regatherChanged(const float* field, const std::int32_t* off, int count, const std::int32_t* newBase,
                      BlockStencils& s) {
   for (int k = 0; k < count; ++k) {
     if (newBase[k] == s.base[k]) continue;
@@ -78,7 +78,7 @@ void regatherChanged(const float* field, const std::int32_t* off, int count, con
 /// u = trilinear(corners; fractions) + (ax, ay, az) for the lanes of a block. The arithmetic of
 /// trilinear() in Trilinear.hpp (x, then y, then z, in double), so the block path and the scalar path
 /// give the same velocities.
-void interpolateBlock(const BlockStencils& s, int count, const double* ax, const double* ay, const double* az,
+inline void interpolateBlock(const BlockStencils& s, int count, const double* ax, const double* ay, const double* az,
                       double* ux, double* uy, double* uz) {
 #pragma omp simd
   for (int k = 0; k < count; ++k) {
