@@ -9,6 +9,7 @@
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <random>
 
 #include "BenchRegistry.hpp"
 #include "SyntheticFields.hpp"
@@ -67,6 +68,14 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
   const char* scalarOnly = std::getenv("RCFD_BENCH_SCALAR_KERNEL");
   const bool vectorised = !(scalarOnly && std::string(scalarOnly) == "1");
   TracerSimulation sim(scene, db, path, {1, warmup + steps, 0, vectorised});
+  if (const char* e = std::getenv("RCFD_BENCH_SHUFFLE"); e && std::string(e) == "1") {
+    TracerCloud& cloud = sim.context().cloud;
+    std::mt19937_64 gen(7);
+    for (std::size_t i = cloud.size(); i > 1; --i) {
+      const std::size_t j = std::uniform_int_distribution<std::size_t>(0, i - 1)(gen);
+      std::swap(cloud.x[i - 1], cloud.x[j]), std::swap(cloud.y[i - 1], cloud.y[j]), std::swap(cloud.z[i - 1], cloud.z[j]);
+    }
+  }
   for (int k = 0; k < std::max(1, warmup); ++k) sim.step();
   const double cpu0 = processCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();

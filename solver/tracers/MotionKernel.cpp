@@ -8,16 +8,11 @@
 #include "core/Errors.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FluctuationModel.hpp"
-#include "tracers/BlockSampling.hpp"
+#include "tracers/BlockLanes.hpp"
+#include "tracers/SingleSphereDrag.hpp"
 #include "tracers/UnitVectors.hpp"
 
 namespace rcfd {
-namespace {
-/// Schiller-Naumann correction of Stokes drag, with the Newton regime constant beyond Re = 1000.
-double dragFactor(double re) {
-  return re < 1000.0 ? 1.0 + 0.15 * std::pow(re, 0.687) : 0.44 * re / 24.0;
-}
-}  // namespace
 
 MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& settings)
     : settings_(settings), apparatus_(ctx.apparatus), grid_(ctx.grid) {
@@ -28,8 +23,7 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
   minSpacing_ = grid_.spacing.minCoeff();
   const auto& p = ctx.scene.particles;
   const auto& g = ctx.scene.gas;
-  particleDiameter_ = p.diameter;
-  gasViscosity_ = g.kinematic_viscosity;
+  reynoldsPerSpeed_ = p.diameter / g.kinematic_viscosity;
   stokesTime_ = p.density * p.diameter * p.diameter / (18.0 * g.density * g.kinematic_viscosity);
   if (settings_.walls) {
     // A point of cell c lies at most half a diagonal from its centre, so its wall distance is at least
@@ -150,170 +144,7 @@ class CornerCache {
   std::int64_t base_ = -1;
   Eigen::Array4d corners_[8];
 };
-
-/// Sub-steps of the lanes of a block so that none moves farther than `limit` (max_courant cells) at
-/// its start velocity u: the arithmetic of substepsFor() in move(). `over` marks lanes capped at
-/// kMaxSubsteps (also a non-finite u).
-void substepsOfBlock(const double* ux, const double* uy, const double* uz, int count, double dt, double limit,
-                     double* h, std::int32_t* left, std::int32_t* over) {
-  constexpr double kMax = MotionKernel::kMaxSubsteps;
-#pragma omp simd
-  for (int k = 0; k < count; ++k) {
-    const double distance = std::sqrt(ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * dt;
-    const double courant = distance / limit;
-    const bool within = courant <= kMax;  // false also for NaN
-    const double c = within ? courant : kMax;
-    // ceil(c) from rint (round to nearest): GCC 12 vectorises rint but not ceil without -fno-trapping-math.
-    const double nearest = std::rint(c);
-    const double rounded = nearest < c ? nearest + 1.0 : nearest;
-    const double nsub = rounded > 1.0 ? rounded : 1.0;
-    h[k] = dt / nsub;
-    left[k] = std::int32_t(nsub) - 1;
-    over[k] = within ? 0 : 1;
-  }
-}
-
 }  // namespace
-
-namespace block {
-/// Tracer lanes of a block that move along u_P^rec (not in free flight), in one sub-step round: views
-/// of the cloud's arrays (the common case, no copies) or of a LaneStorage (compacted lanes).
-struct Lanes {
-  double *x, *y, *z;         ///< position [m]
-  const double *ax, *ay, *az;  ///< u_fluc of Eq. (10) [m/s]
-  double *ux, *uy, *uz;      ///< velocity of the sub-step [m/s]
-  double* h;                 ///< sub-step [s]
-  std::int32_t* left;        ///< sub-steps still to take after this round
-  int count = 0;
-};
-
-/// Storage of compacted lanes.
-struct LaneStorage {
-  alignas(64) double x[kBlock], y[kBlock], z[kBlock];
-  alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];
-  alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];
-  alignas(64) double h[kBlock];
-  alignas(64) std::int32_t left[kBlock];
-  std::int32_t lane[kBlock];  ///< the lane's index in the lanes it was compacted from
-  Lanes view(int count) { return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count}; }
-};
-
-/// What every sub-step round of a move() reads: the step field, the grid and the walls as plain values.
-struct Context {
-  const float* field = nullptr;     ///< u_P^rec of the step, 4 floats per cell
-  const float* cellData = nullptr;  ///< MotionKernel::cellData_
-  const float* plateReach = nullptr;  ///< per cell, or null without draft plates
-  TrilinearLocator::Constants q{};
-  std::int32_t corner4[8] = {};     ///< corner offsets in floats of the step field
-  double origin[3] = {}, inv[3] = {}, spacing[3] = {};
-  int last[3] = {};
-  std::int32_t sy = 0, sz = 0;
-  static constexpr int kMaxHalfSpaces = 16;
-  int halfSpaces = 0;               ///< 0: no half-space test (walls off, or an outline too complex)
-  double hx[kMaxHalfSpaces] = {}, hy[kMaxHalfSpaces] = {}, hz[kMaxHalfSpaces] = {}, hc[kMaxHalfSpaces] = {};
-  double margin = 0.0;              ///< 2 boundaryTolerance() [m]
-  double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
-  bool midpoint = true;
-  bool walls = true;
-};
-}  // namespace block
-
-void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sampled, const block::Context& bc,
-                           MotionStatistics& st) const {
-  using namespace block;
-  const int m = L.count;
-  if (!sampled) {  // Eq. (9): u_P^rec at the sub-step's start
-    locateBlock(bc.q, m, L.x, L.y, L.z, s, nullptr);
-    gatherBlock(bc.field, bc.corner4, m, s);
-    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
-  }
-  if (bc.midpoint) {
-    // Midpoint rule (see moveOne); its stencil reuses the start's corners where it is the same.
-    alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];
-    alignas(64) std::int32_t midBase[kBlock];
-#pragma omp simd
-    for (int k = 0; k < m; ++k) {
-      const double half = 0.5 * L.h[k];
-      mx[k] = L.x[k] + half * L.ux[k], my[k] = L.y[k] + half * L.uy[k], mz[k] = L.z[k] + half * L.uz[k];
-    }
-    locateBlock(bc.q, m, mx, my, mz, s, midBase);
-    regatherChanged(bc.field, bc.corner4, m, midBase, s);
-    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
-  }
-  // Plain local pointers: the vectoriser does not look through the view's members.
-  double* const x = L.x;
-  double* const y = L.y;
-  double* const z = L.z;
-  const double* const ux = L.ux;
-  const double* const uy = L.uy;
-  const double* const uz = L.uz;
-  const double* const h = L.h;
-  // Walls, first test: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move
-  // inside (signed distances are 1-Lipschitz).
-  alignas(64) std::int64_t fast[kBlock];
-  alignas(64) double ex[kBlock], ey[kBlock], ez[kBlock];  // end points
-  alignas(64) double off[kBlock], length[kBlock];
-  alignas(64) std::int32_t cell[kBlock];
-  const float* cellData = bc.cellData;
-  const double noWall = bc.noWall;
-  std::int64_t pending = 0;
-#pragma omp simd reduction(+ : pending)
-  for (int k = 0; k < m; ++k) {
-    const double dx = h[k] * ux[k], dy = h[k] * uy[k], dz = h[k] * uz[k];
-    ex[k] = x[k] + dx, ey[k] = y[k] + dy, ez[k] = z[k] + dz;
-    length[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
-    int ci[3];
-    double off2 = 0.0;
-    const double pk[3] = {x[k], y[k], z[k]};
-    for (int d = 0; d < 3; ++d) {
-      const double t = (pk[d] - bc.origin[d]) * bc.inv[d];
-      const int i = int(t > 0.0 ? t : 0.0);
-      ci[d] = i < bc.last[d] ? i : bc.last[d];
-      const double e = pk[d] - (bc.origin[d] + (double(ci[d]) + 0.5) * bc.spacing[d]);
-      off2 += e * e;
-    }
-    off[k] = std::sqrt(off2);
-    cell[k] = ci[0] + ci[1] * bc.sy + ci[2] * bc.sz;
-    const double reach = double(cellData[2 * cell[k]]) + noWall;
-    fast[k] = off[k] + length[k] < reach;
-    pending += 1 - fast[k];
-  }
-  // Second test, for moves near a wall: the end at least `margin` inside every half-space of the
-  // outline and the z walls, and the whole move farther than the hit band from the draft plates. Then
-  // firstIntersection() reports no hit: from a start clear of a wall's band both ends are clear, and
-  // from a start inside the band the move goes inwards, which is not a hit either.
-  if (pending > 0 && bc.halfSpaces > 0) {
-    const double margin = bc.margin;
-    const float* plateReach = bc.plateReach;
-    alignas(64) std::int64_t inside[kBlock];
-    if (plateReach) {
-#pragma omp simd
-      for (int k = 0; k < m; ++k) inside[k] = off[k] + length[k] < double(plateReach[cell[k]]);
-    } else {
-      for (int k = 0; k < m; ++k) inside[k] = 1;
-    }
-    for (int j = 0; j < bc.halfSpaces; ++j) {
-      const double nx = bc.hx[j], ny = bc.hy[j], nz = bc.hz[j], c = bc.hc[j];
-#pragma omp simd
-      for (int k = 0; k < m; ++k) inside[k] &= std::int64_t(nx * ex[k] + ny * ey[k] + nz * ez[k] - c >= margin);
-    }
-#pragma omp simd
-    for (int k = 0; k < m; ++k) fast[k] |= inside[k];
-  }
-#pragma omp simd
-  for (int k = 0; k < m; ++k) {
-    if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];  // masked stores
-  }
-  // The rest meet a wall or pass close to one: the exact segment test and mirror reflection.
-  for (int k = 0; k < m; ++k) {
-    if (fast[k]) continue;
-    Eigen::Vector3d p(x[k], y[k], z[k]);
-    const Eigen::Vector3d u(ux[k], uy[k], uz[k]);
-    st.wallHits += moveWithWalls(p, h[k] * u, nullptr, 1.0);
-    ++st.exactWallTests;
-    x[k] = p.x(), y[k] = p.y(), z[k] = p.z();
-  }
-}
 
 void MotionKernel::move(TracerContext& ctx) {
   using namespace block;
@@ -345,6 +176,11 @@ void MotionKernel::move(TracerContext& ctx) {
 
   Context bc;
   bc.field = particleVelocity_.floats();
+  bc.gasField = settings_.freeFlight ? gasVelocity_.floats() : nullptr;
+  bc.stokesTime = stokesTime_;
+  bc.reynoldsPerSpeed = reynoldsPerSpeed_;
+  for (int d = 0; d < 3; ++d) bc.gravity[d] = gravity_[d];
+  bc.restitution = settings_.wallRestitution;
   bc.cellData = cellData_.data();
   bc.plateReach = plateReach_.empty() ? nullptr : plateReach_.data();
   bc.q = locator.constants();
@@ -381,8 +217,8 @@ void MotionKernel::move(TracerContext& ctx) {
       const double h = dt / nsub;
       for (int s = 0; s < nsub; ++s) {
         const Eigen::Vector3d ug = gas.sample(p);
-        const double re = (ug - v).norm() * particleDiameter_ / gasViscosity_;
-        const double tau = stokesTime_ / dragFactor(re);
+        const double re = (ug - v).norm() * reynoldsPerSpeed_;
+        const double tau = stokesTime_ / singleSphereDragFactor(re);
         v = (v + h * (ug / tau + gravity_)) / (1.0 + h / tau);
         st.wallHits += moveWithWalls(p, h * v, &v, settings_.wallRestitution, s == 0 ? firstClearance : -1.0);
       }
@@ -486,46 +322,41 @@ void MotionKernel::move(TracerContext& ctx) {
       locateBlock(bc.q, m, L.x, L.y, L.z, stencils, nullptr);
       gatherBlock(bc.field, bc.corner4, m, stencils);
       interpolateBlock(stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
-      std::int64_t extra = 0, cappedHere = 0;
-      std::int32_t maxLeft = 0;
       alignas(64) std::int32_t over[kBlock];
-      substepsOfBlock(L.ux, L.uy, L.uz, m, dt, cellLimit, L.h, L.left, over);
-      for (int k = 0; k < m; ++k) {
-        extra += L.left[k], cappedHere += over[k];
-        maxLeft = std::max(maxLeft, L.left[k]);
-      }
-      st.substeps += extra, st.substepCapped += cappedHere;
-      subStep(L, stencils, true, bc, st);
-      // Further sub-steps (fast tracers, mostly in the spout): the lanes that still have some, compacted.
-      for (std::int32_t round = 1; round <= maxLeft; ++round) {
-        LaneStorage rs;
-        int r = 0;
-        for (int k = 0; k < m; ++k) {
-          if (L.left[k] <= 0) continue;
-          rs.x[r] = L.x[k], rs.y[r] = L.y[k], rs.z[r] = L.z[k];
-          rs.ax[r] = L.ax[k], rs.ay[r] = L.ay[k], rs.az[r] = L.az[k];
-          rs.h[r] = L.h[k];
-          rs.lane[r++] = k;
-          --L.left[k];
+      auto countSubsteps = [&](Lanes& lanes) {
+        substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, cellLimit, lanes.h, lanes.left, over,
+                        double(kMaxSubsteps));
+        std::int32_t maxLeft = 0;
+        for (int k = 0; k < lanes.count; ++k) {
+          st.substeps += lanes.left[k], st.substepCapped += over[k];
+          maxLeft = std::max(maxLeft, lanes.left[k]);
         }
-        Lanes R = rs.view(r);
-        subStep(R, stencils, false, bc, st);
-        for (int j = 0; j < r; ++j) {
-          const int k = rs.lane[j];
-          L.x[k] = R.x[j], L.y[k] = R.y[j], L.z[k] = R.z[j];
-          L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
-        }
-      }
+        return maxLeft;
+      };
+      advanceLanes(L, countSubsteps(L), stencils, false, bc, st);
       if (freeLanes > 0) {
         for (int j = 0; j < m; ++j) {
           const std::int64_t i = i0 + compact.lane[j];
           px[i] = L.x[j], py[i] = L.y[j], pz[i] = L.z[j];
           pvx[i] = L.ux[j], pvy[i] = L.uy[j], pvz[i] = L.uz[j];
         }
+        // Free flight: the tracers' own velocities, sub-stepped by them.
+        LaneStorage fs;
+        int f = 0;
         for (int k = 0; k < count; ++k) {
           if (!free[k]) continue;
-          moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
-          ++st.scalarPath;
+          fs.x[f] = px[i0 + k], fs.y[f] = py[i0 + k], fs.z[f] = pz[i0 + k];
+          fs.ux[f] = pvx[i0 + k], fs.uy[f] = pvy[i0 + k], fs.uz[f] = pvz[i0 + k];
+          fs.ax[f] = fs.ay[f] = fs.az[f] = 0.0;
+          fs.lane[f++] = k;
+        }
+        Lanes F = fs.view(f);
+        st.freeFlight += f;
+        advanceLanes(F, countSubsteps(F), stencils, true, bc, st);
+        for (int j = 0; j < f; ++j) {
+          const std::int64_t i = i0 + fs.lane[j];
+          px[i] = F.x[j], py[i] = F.y[j], pz[i] = F.z[j];
+          pvx[i] = F.ux[j], pvy[i] = F.uy[j], pvz[i] = F.uz[j];
         }
       }
     }

@@ -50,10 +50,19 @@ class MotionKernel {
  private:
   /// Builds the step's velocity fields and cell table from the context's frames and tracer alpha_P.
   void prepare(const TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
-  /// One sub-step of a block's lanes along u_P^rec (sampled at the start already when `sampled`):
-  /// midpoint, the vectorised wall tests, then the exact segment test for the moves they do not clear.
+  // The block path (MotionKernelBlock.cpp).
+  /// All sub-steps of a block's lanes, the first for every lane, then the lanes with more, compacted.
+  void advanceLanes(block::Lanes& lanes, std::int32_t maxLeft, block::BlockStencils& stencils, bool freeFlying,
+                    const block::Context& bc, MotionStatistics& st) const;
+  /// One sub-step of lanes along u_P^rec + u_fluc (sampled at the start already when `sampled`).
   void subStep(block::Lanes& lanes, block::BlockStencils& stencils, bool sampled, const block::Context& bc,
                MotionStatistics& st) const;
+  /// One sub-step of free-flying lanes: drag toward u_G^rec and gravity, then the move.
+  void freeFlightSubStep(block::Lanes& lanes, block::BlockStencils& stencils, const block::Context& bc,
+                         MotionStatistics& st) const;
+  /// The moves of a sub-step: the vectorised wall tests, then the exact segment test (and, for free
+  /// flight, the velocity's reflection) for the moves they do not clear.
+  void moveLanes(block::Lanes& lanes, const block::Context& bc, MotionStatistics& st, bool freeFlying) const;
 
   MotionSettings settings_;
   const Apparatus& apparatus_;
@@ -64,8 +73,7 @@ class MotionKernel {
   std::vector<Apparatus::HalfSpace> halfSpaces_;  ///< the open region's convex part
   double minSpacing_;
   double stokesTime_;             ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
-  double particleDiameter_;
-  double gasViscosity_;
+  double reynoldsPerSpeed_;       ///< d_P / nu_G [s/m]
   Eigen::Vector3d gravity_{0.0, -9.81, 0.0};
   MotionStatistics stats_;
   StepVelocityField particleVelocity_;  ///< u_P^rec of the step

@@ -1,0 +1,82 @@
+#pragma once
+/// \file BlockLanes.hpp
+/// The motion kernel's block path (internal): the lanes of a block of tracers that move together
+/// through one sub-step round, and the step's constants those rounds read as plain values (the
+/// vectoriser does not look through members of the kernel).
+
+#include <cmath>
+#include <cstdint>
+
+#include "tracers/BlockSampling.hpp"
+
+namespace rcfd::block {
+
+/// Tracer lanes of a block that move along u_P^rec (not in free flight), in one sub-step round: views
+/// of the cloud's arrays (the common case, no copies) or of a LaneStorage (compacted lanes).
+struct Lanes {
+  double *x, *y, *z;         ///< position [m]
+  const double *ax, *ay, *az;  ///< u_fluc of Eq. (10) [m/s]
+  double *ux, *uy, *uz;      ///< velocity of the sub-step [m/s]
+  double* h;                 ///< sub-step [s]
+  std::int32_t* left;        ///< sub-steps still to take after this round
+  int count = 0;
+};
+
+/// Storage of compacted lanes.
+struct LaneStorage {
+  alignas(64) double x[kBlock], y[kBlock], z[kBlock];
+  alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];
+  alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];
+  alignas(64) double h[kBlock];
+  alignas(64) std::int32_t left[kBlock];
+  std::int32_t lane[kBlock];  ///< the lane's index in the lanes it was compacted from
+  Lanes view(int count) { return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count}; }
+};
+
+/// What every sub-step round of a move() reads: the step field, the grid and the walls as plain values.
+struct Context {
+  const float* field = nullptr;     ///< u_P^rec of the step, 4 floats per cell
+  const float* gasField = nullptr;  ///< u_G^rec of the step, 4 floats per cell (free flight only)
+  const float* cellData = nullptr;  ///< MotionKernel::cellData_
+  const float* plateReach = nullptr;  ///< per cell, or null without draft plates
+  TrilinearLocator::Constants q{};
+  std::int32_t corner4[8] = {};     ///< corner offsets in floats of the step field
+  double origin[3] = {}, inv[3] = {}, spacing[3] = {};
+  int last[3] = {};
+  std::int32_t sy = 0, sz = 0;
+  static constexpr int kMaxHalfSpaces = 16;
+  int halfSpaces = 0;               ///< 0: no half-space test (walls off, or an outline too complex)
+  double hx[kMaxHalfSpaces] = {}, hy[kMaxHalfSpaces] = {}, hz[kMaxHalfSpaces] = {}, hc[kMaxHalfSpaces] = {};
+  double margin = 0.0;              ///< 2 boundaryTolerance() [m]
+  double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
+  double stokesTime = 0.0;          ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
+  double reynoldsPerSpeed = 0.0;    ///< d_P / nu_G [s/m]
+  double gravity[3] = {};           ///< [m/s2]
+  double restitution = 1.0;         ///< normal restitution of free-flying tracers at walls [-]
+  bool midpoint = true;
+  bool walls = true;
+};
+
+/// Sub-steps of the lanes of a block so that none moves farther than `limit` (max_courant cells) at
+/// its start velocity u: the arithmetic of substepsFor() in move(). `over` marks lanes capped at
+/// kMax sub-steps (also a non-finite u).
+inline void substepsOfBlock(const double* ux, const double* uy, const double* uz, int count, double dt, double limit,
+                     double* h, std::int32_t* left, std::int32_t* over, double kMax) {
+  
+#pragma omp simd
+  for (int k = 0; k < count; ++k) {
+    const double distance = std::sqrt(ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * dt;
+    const double courant = distance / limit;
+    const bool within = courant <= kMax;  // false also for NaN
+    const double c = within ? courant : kMax;
+    // ceil(c) from rint (round to nearest): GCC 12 vectorises rint but not ceil without -fno-trapping-math.
+    const double nearest = std::rint(c);
+    const double rounded = nearest < c ? nearest + 1.0 : nearest;
+    const double nsub = rounded > 1.0 ? rounded : 1.0;
+    h[k] = dt / nsub;
+    left[k] = std::int32_t(nsub) - 1;
+    over[k] = within ? 0 : 1;
+  }
+}
+
+}  // namespace rcfd::block

@@ -1,0 +1,182 @@
+// The motion kernel's block path: lanes of a block of tracers sub-stepped together in loops the
+// compiler vectorises, with the scalar path's arithmetic (MotionKernel.cpp), so both give the same
+// trajectories.
+#include <cmath>
+
+#include "tracers/BlockLanes.hpp"
+#include "tracers/MotionKernel.hpp"
+#include "tracers/SingleSphereDrag.hpp"
+
+namespace rcfd {
+
+using namespace block;
+
+void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sampled, const block::Context& bc,
+                           MotionStatistics& st) const {
+  const int m = L.count;
+  if (!sampled) {  // Eq. (9): u_P^rec at the sub-step's start
+    locateBlock(bc.q, m, L.x, L.y, L.z, s, nullptr);
+    gatherBlock(bc.field, bc.corner4, m, s);
+    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+  }
+  if (bc.midpoint) {
+    // Midpoint rule (see moveOne); its stencil reuses the start's corners where it is the same.
+    alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];
+    alignas(64) std::int32_t midBase[kBlock];
+#pragma omp simd
+    for (int k = 0; k < m; ++k) {
+      const double half = 0.5 * L.h[k];
+      mx[k] = L.x[k] + half * L.ux[k], my[k] = L.y[k] + half * L.uy[k], mz[k] = L.z[k] + half * L.uz[k];
+    }
+    locateBlock(bc.q, m, mx, my, mz, s, midBase);
+    regatherChanged(bc.field, bc.corner4, m, midBase, s);
+    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+  }
+  moveLanes(L, bc, st, false);
+}
+
+void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionStatistics& st, bool freeFlying) const {
+  const int m = L.count;
+  // Plain local pointers: the vectoriser does not look through the view's members.
+  double* const x = L.x;
+  double* const y = L.y;
+  double* const z = L.z;
+  double* const ux = L.ux;
+  double* const uy = L.uy;
+  double* const uz = L.uz;
+  const double* const h = L.h;
+  // Walls, first test: |p - c| + |disp| < reach(c) for the centre c of p's cell keeps the whole move
+  // inside (signed distances are 1-Lipschitz).
+  alignas(64) std::int64_t fast[kBlock];
+  alignas(64) double ex[kBlock], ey[kBlock], ez[kBlock];  // end points
+  alignas(64) double off[kBlock], length[kBlock];
+  alignas(64) std::int32_t cell[kBlock];
+  const float* cellData = bc.cellData;
+  const double noWall = bc.noWall;
+  std::int64_t pending = 0;
+#pragma omp simd reduction(+ : pending)
+  for (int k = 0; k < m; ++k) {
+    const double dx = h[k] * ux[k], dy = h[k] * uy[k], dz = h[k] * uz[k];
+    ex[k] = x[k] + dx, ey[k] = y[k] + dy, ez[k] = z[k] + dz;
+    length[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
+    int ci[3];
+    double off2 = 0.0;
+    const double pk[3] = {x[k], y[k], z[k]};
+    for (int d = 0; d < 3; ++d) {
+      const double t = (pk[d] - bc.origin[d]) * bc.inv[d];
+      const int i = int(t > 0.0 ? t : 0.0);
+      ci[d] = i < bc.last[d] ? i : bc.last[d];
+      const double e = pk[d] - (bc.origin[d] + (double(ci[d]) + 0.5) * bc.spacing[d]);
+      off2 += e * e;
+    }
+    off[k] = std::sqrt(off2);
+    cell[k] = ci[0] + ci[1] * bc.sy + ci[2] * bc.sz;
+    const double reach = double(cellData[2 * cell[k]]) + noWall;
+    fast[k] = off[k] + length[k] < reach;
+    pending += 1 - fast[k];
+  }
+  // Second test, for moves near a wall: the end at least `margin` inside every half-space of the
+  // outline and the z walls, and the whole move farther than the hit band from the draft plates. Then
+  // firstIntersection() reports no hit: from a start clear of a wall's band both ends are clear, and
+  // from a start inside the band the move goes inwards, which is not a hit either.
+  if (pending > 0 && bc.halfSpaces > 0) {
+    const double margin = bc.margin;
+    const float* plateReach = bc.plateReach;
+    alignas(64) std::int64_t inside[kBlock];
+    if (plateReach) {
+#pragma omp simd
+      for (int k = 0; k < m; ++k) inside[k] = off[k] + length[k] < double(plateReach[cell[k]]);
+    } else {
+      for (int k = 0; k < m; ++k) inside[k] = 1;
+    }
+    for (int j = 0; j < bc.halfSpaces; ++j) {
+      const double nx = bc.hx[j], ny = bc.hy[j], nz = bc.hz[j], c = bc.hc[j];
+#pragma omp simd
+      for (int k = 0; k < m; ++k) inside[k] &= std::int64_t(nx * ex[k] + ny * ey[k] + nz * ez[k] - c >= margin);
+    }
+#pragma omp simd
+    for (int k = 0; k < m; ++k) fast[k] |= inside[k];
+  }
+#pragma omp simd
+  for (int k = 0; k < m; ++k) {
+    if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];  // masked stores
+  }
+  // The rest meet a wall or pass close to one: the exact segment test and mirror reflection, which
+  // for a free-flying tracer also reflects its velocity with the restitution coefficient.
+  for (int k = 0; k < m; ++k) {
+    if (fast[k]) continue;
+    Eigen::Vector3d p(x[k], y[k], z[k]);
+    Eigen::Vector3d u(ux[k], uy[k], uz[k]);
+    st.wallHits += moveWithWalls(p, h[k] * u, freeFlying ? &u : nullptr, bc.restitution);
+    ++st.exactWallTests;
+    x[k] = p.x(), y[k] = p.y(), z[k] = p.z();
+    ux[k] = u.x(), uy[k] = u.y(), uz[k] = u.z();
+  }
+}
+
+
+void MotionKernel::freeFlightSubStep(block::Lanes& F, block::BlockStencils& s, const block::Context& bc,
+                                     MotionStatistics& st) const {
+  const int m = F.count;
+  // u_G^rec at the sub-step's start (no fluctuation in free flight).
+  alignas(64) static constexpr double kZero[kBlock] = {};
+  alignas(64) double gx[kBlock], gy[kBlock], gz[kBlock];
+  locateBlock(bc.q, m, F.x, F.y, F.z, s, nullptr);
+  gatherBlock(bc.gasField, bc.corner4, m, s);
+  interpolateBlock(s, m, kZero, kZero, kZero, gx, gy, gz);
+  // Implicit drag relaxation toward u_G^rec plus gravity, stable for any h / tau (as moveOne).
+  double* const vx = F.ux;
+  double* const vy = F.uy;
+  double* const vz = F.uz;
+  const double* const h = F.h;
+  const double stokesTime = bc.stokesTime, rePerSpeed = bc.reynoldsPerSpeed;
+  const double g0 = bc.gravity[0], g1 = bc.gravity[1], g2 = bc.gravity[2];
+#pragma omp simd
+  for (int k = 0; k < m; ++k) {
+    const double dx = gx[k] - vx[k], dy = gy[k] - vy[k], dz = gz[k] - vz[k];
+    const double re = std::sqrt(dx * dx + dy * dy + dz * dz) * rePerSpeed;
+    const double tau = stokesTime / singleSphereDragFactor(re);
+    const double denominator = 1.0 + h[k] / tau;
+    vx[k] = (vx[k] + h[k] * (gx[k] / tau + g0)) / denominator;
+    vy[k] = (vy[k] + h[k] * (gy[k] / tau + g1)) / denominator;
+    vz[k] = (vz[k] + h[k] * (gz[k] / tau + g2)) / denominator;
+  }
+  moveLanes(F, bc, st, true);
+}
+
+void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::BlockStencils& s, bool freeFlying,
+                                const block::Context& bc, MotionStatistics& st) const {
+  const int m = L.count;
+  if (freeFlying) {
+    freeFlightSubStep(L, s, bc, st);
+  } else {
+    subStep(L, s, true, bc, st);  // the caller sampled the start to count the sub-steps
+  }
+  // Further sub-steps (fast tracers, mostly in the spout): the lanes that still have some, compacted.
+  for (std::int32_t round = 1; round <= maxLeft; ++round) {
+    LaneStorage rs;
+    int r = 0;
+    for (int k = 0; k < m; ++k) {
+      if (L.left[k] <= 0) continue;
+      rs.x[r] = L.x[k], rs.y[r] = L.y[k], rs.z[r] = L.z[k];
+      rs.ax[r] = L.ax[k], rs.ay[r] = L.ay[k], rs.az[r] = L.az[k];
+      rs.ux[r] = L.ux[k], rs.uy[r] = L.uy[k], rs.uz[r] = L.uz[k];
+      rs.h[r] = L.h[k];
+      rs.lane[r++] = k;
+      --L.left[k];
+    }
+    Lanes R = rs.view(r);
+    if (freeFlying) {
+      freeFlightSubStep(R, s, bc, st);
+    } else {
+      subStep(R, s, false, bc, st);
+    }
+    for (int j = 0; j < r; ++j) {
+      const int k = rs.lane[j];
+      L.x[k] = R.x[j], L.y[k] = R.y[j], L.z[k] = R.z[j];
+      L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
+    }
+  }
+}
+
+}  // namespace rcfd
