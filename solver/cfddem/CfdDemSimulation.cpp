@@ -52,9 +52,10 @@ CfdDemSimulation::CfdDemSimulation(const Scene& scene, std::uint64_t seed, const
 
 CfdDemSimulation::~CfdDemSimulation() = default;
 
-FillResult CfdDemSimulation::fillAndSettle() {
+FillResult CfdDemSimulation::fillAndSettle(const std::function<bool()>& stopRequested) {
   FillOptions options;
   options.seed = seed_;
+  options.stop_requested = stopRequested;
   options.max_settle_time = scene_.dem.settle_time;
   const FillResult r = rcfd::fillAndSettle(*dem_, defaultFillRegion(scene_.apparatus), parcelsForBedMass(scene_), options);
   demStep_ = dem_->steps();

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,7 +57,7 @@ class CfdDemSimulation {
 
   /// Inserts the scene's bed mass as parcels and lets it settle (DEM only, gas off), at most
   /// scene.dem.settle_time. Deterministic for the seed.
-  FillResult fillAndSettle();
+  FillResult fillAndSettle(const std::function<bool()>& stopRequested = {});
 
   /// Scales the inlet and nozzle flows by factor in [0, 1] (the database job ramps the gas up).
   void setFlowFactor(double factor);

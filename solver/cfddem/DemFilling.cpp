@@ -32,13 +32,26 @@ FillRegion defaultFillRegion(const ApparatusSpec& a) {
   return r;
 }
 
-double settle(DemSystem& dem, double max_time, double fraction, bool* settled) {
+namespace {
+/// DEM steps of about one millisecond: how often filling and settling look at the stop request.
+long stepsPerMillisecond(const DemSystem& dem) { return std::max(1L, static_cast<long>(1e-3 / dem.timeStep())); }
+
+void throwIfStopRequested(const DemSystem& dem, const std::function<bool()>& stop_requested) {
+  if (stop_requested && stop_requested())
+    throw Cancelled("stopped while filling and settling the bed at t = " + std::to_string(dem.time()) +
+                    " s; nothing is kept: the next run fills again");
+}
+}  // namespace
+
+double settle(DemSystem& dem, double max_time, double fraction, bool* settled,
+              const std::function<bool()>& stop_requested) {
   const DemParticles& p = dem.particles();
   const double g = dem.settings().gravity.norm();
   const double t0 = dem.time();
-  const long check = std::max(1L, static_cast<long>(1e-3 / dem.timeStep()));  // every 1 ms
+  const long check = stepsPerMillisecond(dem);
   bool ok = false;
   while (dem.time() - t0 < max_time) {
+    throwIfStopRequested(dem, stop_requested);
     dem.run(check);
     double ref = 0.0;
     for (std::size_t i = 0; i < p.size(); ++i) ref += p.mass[i] * g * p.radius[i];
@@ -123,11 +136,17 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
     spdlog::debug("DEM filling: batch {} inserted {} parcels ({} of {})", result.batches, batch,
                   result.inserted, count);
     if (batch == 0 && g == 0.0) throw RunError("DEM filling: no room and no gravity to make room");
-    // Let the batch fall clear (after the last one too, so settling starts with the bed in motion).
-    dem.run(std::max(1L, std::lround(fall_time / dem.timeStep())));
+    // Let the batch fall clear (after the last one too, so settling starts with the bed in motion),
+    // a millisecond at a time so a stop request is seen.
+    for (long left = std::max(1L, std::lround(fall_time / dem.timeStep())); left > 0;) {
+      throwIfStopRequested(dem, o.stop_requested);
+      const long chunk = std::min(left, stepsPerMillisecond(dem));
+      dem.run(chunk);
+      left -= chunk;
+    }
   }
   result.fill_time = dem.time() - t0;
-  result.settle_time = settle(dem, o.max_settle_time, o.settled_energy_fraction, &result.settled);
+  result.settle_time = settle(dem, o.max_settle_time, o.settled_energy_fraction, &result.settled, o.stop_requested);
   result.kinetic_energy = dem.particles().kineticEnergy();
   spdlog::info("DEM filling: {} parcels in {} batches, {:.3f} s falling + {:.3f} s settling, {}",
                result.inserted, result.batches, result.fill_time, result.settle_time,

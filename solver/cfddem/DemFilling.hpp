@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 
 #include "cfddem/DemSystem.hpp"
 #include "scene/Scene.hpp"
@@ -25,6 +26,9 @@ struct FillOptions {
   /// sqrt(2 fraction g r)) [-].
   double settled_energy_fraction = 1e-3;
   int max_batches = 200;           ///< refuse to go on when the region never takes all parcels
+  /// Polled about every millisecond of simulated time; true stops the filling with rcfd::Cancelled
+  /// (a half-filled bed is no state to resume from: the caller fills again). Empty: never.
+  std::function<bool()> stop_requested;
 };
 
 struct FillResult {
@@ -44,11 +48,14 @@ long parcelsForBedMass(const Scene& scene);
 FillRegion defaultFillRegion(const ApparatusSpec& apparatus);
 
 /// Inserts `count` parcels in `region` (clear of walls and of each other), lets them fall and settles.
-/// Throws rcfd::RunError when the region cannot take the parcels within max_batches.
+/// Throws rcfd::RunError when the region cannot take the parcels within max_batches, rcfd::Cancelled
+/// when options.stop_requested says so.
 FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count,
                          const FillOptions& options = {});
 
 /// Runs until the kinetic energy criterion holds or max_time passes; returns the time run [s].
-double settle(DemSystem& dem, double max_time, double settled_energy_fraction, bool* settled = nullptr);
+/// `stop_requested` as in FillOptions.
+double settle(DemSystem& dem, double max_time, double settled_energy_fraction, bool* settled = nullptr,
+              const std::function<bool()>& stop_requested = {});
 
 }  // namespace rcfd

@@ -127,7 +127,9 @@ class DatabaseJob final : public JobRunner {
 
     if (!st.settled) {
       progress->report(0.0, sim.time(), true);
-      st.fill = sim.fillAndSettle();
+      // A stop request during the filling ends the job without a checkpoint (Cancelled, exit 130): a
+      // half-filled bed is no state to resume from, and the filling is redone from the seed.
+      st.fill = sim.fillAndSettle([] { return cancellationRequested(); });
       st.settled = true;
       st.settledStep = sim.demStep();
       makeRecorder();

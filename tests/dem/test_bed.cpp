@@ -10,6 +10,7 @@
 #include "ProCellSection.hpp"
 #include "cfddem/ApparatusWalls.hpp"
 #include "cfddem/DemFilling.hpp"
+#include "core/Errors.hpp"
 
 namespace rcfd {
 namespace {
@@ -66,6 +67,29 @@ TEST(Bed, PouredBedPacksBetween058And064) {
   RecordProperty("packing_fraction", std::to_string(phi));
   EXPECT_GT(phi, 0.58);
   EXPECT_LT(phi, 0.64);
+}
+
+TEST(Bed, AStopRequestEndsTheFillingWithinAMillisecondOfSimulatedTime) {
+  // A cancelled database job must not wait for the whole filling (~40 s of wall time for quick.json):
+  // the stop request is polled every millisecond of simulated time, while batches fall and settle.
+  const double r = 1.5e-3;
+  const DemMaterial m = material(r, 0.9, 0.75, 0.5, 0.24, 0.06, 0.05, 5e5, 1040.0);
+  DemSettings s;
+  s.time_step = 0.25 * m.rayleighTime();
+  const Vector3d lo(-0.015, 0.0, 0.0), hi(0.015, 0.15, 0.03);
+  DemSystem dem(m, DemWalls::box(lo, hi), s);
+  FillOptions o;
+  int polls = 0;
+  o.stop_requested = [&] { return ++polls > 20; };  // after 20 ms of falling
+  EXPECT_THROW(fillAndSettle(dem, FillRegion{Vector3d(lo.x(), 0.05, lo.z()), hi}, 1500, o), Cancelled);
+  EXPECT_EQ(polls, 21);
+  EXPECT_LE(dem.time(), 0.020 + 1e-3 + 1e-12);
+  EXPECT_GT(dem.time(), 0.015);  // chunks of whole DEM steps just under a millisecond
+  // Without a request the same call fills everything (the first batch alone takes 0.15 s to fall).
+  DemSystem full(m, DemWalls::box(lo, hi), s);
+  o.stop_requested = [] { return false; };
+  o.max_settle_time = 0.01;
+  EXPECT_EQ(fillAndSettle(full, FillRegion{Vector3d(lo.x(), 0.05, lo.z()), hi}, 200, o).inserted, 200);
 }
 
 TEST(Bed, ProCellSettlesIntoTheVWithNothingOutside) {
