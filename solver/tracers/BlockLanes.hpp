@@ -49,6 +49,8 @@ struct Context {
   double hx[kMaxHalfSpaces] = {}, hy[kMaxHalfSpaces] = {}, hz[kMaxHalfSpaces] = {}, hc[kMaxHalfSpaces] = {};
   double margin = 0.0;              ///< 2 boundaryTolerance() [m]
   double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
+  static constexpr int kMaxSubsteps = 64;  ///< MotionKernel::kMaxSubsteps
+  double substepLength[kMaxSubsteps + 1] = {};  ///< [n] = dt / n [s]
   double stokesTime = 0.0;          ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
   double reynoldsPerSpeed = 0.0;    ///< d_P / nu_G [s/m]
   double gravity[3] = {};           ///< [m/s2]
@@ -57,26 +59,38 @@ struct Context {
   bool walls = true;
 };
 
-/// Sub-steps of the lanes of a block so that none moves farther than `limit` (max_courant cells) at
-/// its start velocity u: the arithmetic of substepsFor() in move(). `over` marks lanes capped at
-/// kMax sub-steps (also a non-finite u).
-inline void substepsOfBlock(const double* ux, const double* uy, const double* uz, int count, double dt, double limit,
-                     double* h, std::int32_t* left, std::int32_t* over, double kMax) {
-  
+/// Sub-steps of the lanes of a block so that none moves farther than max_courant cells at its start
+/// velocity u: the arithmetic of substepsFor() in MotionKernel::move() (courant = |u| dt / limit,
+/// given as its inverse, capped at kMax, also for a non-finite u). The sub-step lengths come from
+/// `lengths` (lengths[n] = dt / n), which spares a division per lane. Adds the extra sub-steps and the
+/// capped lanes to the counters; returns the largest number of extra sub-steps.
+inline std::int32_t substepsOfBlock(const double* ux, const double* uy, const double* uz, int count, double dt,
+                                    double inverseLimit, const double* lengths, double kMax, double* h,
+                                    std::int32_t* left, std::int64_t& extra, std::int64_t& capped) {
+  alignas(64) std::int32_t over[kBlock];
 #pragma omp simd
   for (int k = 0; k < count; ++k) {
     const double distance = std::sqrt(ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * dt;
-    const double courant = distance / limit;
+    const double courant = distance * inverseLimit;
     const bool within = courant <= kMax;  // false also for NaN
     const double c = within ? courant : kMax;
     // ceil(c) from rint (round to nearest): GCC 12 vectorises rint but not ceil without -fno-trapping-math.
     const double nearest = std::rint(c);
     const double rounded = nearest < c ? nearest + 1.0 : nearest;
-    const double nsub = rounded > 1.0 ? rounded : 1.0;
-    h[k] = dt / nsub;
-    left[k] = std::int32_t(nsub) - 1;
+    const std::int32_t nsub = std::int32_t(rounded > 1.0 ? rounded : 1.0);
+    h[k] = lengths[nsub];
+    left[k] = nsub - 1;
     over[k] = within ? 0 : 1;
   }
+  std::int64_t added = 0, cappedHere = 0;
+  std::int32_t maxLeft = 0;
+#pragma omp simd reduction(+ : added, cappedHere) reduction(max : maxLeft)
+  for (int k = 0; k < count; ++k) {
+    added += left[k], cappedHere += over[k];
+    maxLeft = left[k] > maxLeft ? left[k] : maxLeft;
+  }
+  extra += added, capped += cappedHere;
+  return maxLeft;
 }
 
 }  // namespace rcfd::block

@@ -106,19 +106,25 @@ void MotionKernel::prepare(const TracerContext& ctx, const FrameSampler& sampler
   const bool parallel = cells > kParallelThreshold;
   particleVelocity_.build(sampler, false, parallel);
   if (settings_.freeFlight) gasVelocity_.build(sampler, true, parallel);
-  cellData_.resize(2 * std::size_t(cells));
+  if (cellData_.empty()) {
+    cellData_.assign(2 * std::size_t(cells), 0.0f);
+    if (settings_.walls) {
+      for (std::int64_t c = 0; c < cells; ++c) cellData_[2 * std::size_t(c)] = reach_[std::size_t(c)];
+    }
+  }
   const FluctuationModel* model = fluctuate ? settings_.fluctuation : nullptr;
+  if (!model && !hadSpeeds_) return;
+  hadSpeeds_ = model != nullptr;
   const double dt = ctx.dt;
 #pragma omp parallel for schedule(static) if (parallel)
   for (std::int64_t c = 0; c < cells; ++c) {
-    double speed = 0.0;
-    if (model) {
-      // Eq. (10), once per cell instead of once per tracer: it depends on the cell only.
-      speed = std::min(model->speed(ctx.tracerAlpha[std::size_t(c)], sampler.alphaP(c), settings_.d0, dt),
-                       settings_.uFlucMax);
-    }
-    cellData_[2 * std::size_t(c)] = settings_.walls ? reach_[std::size_t(c)] : 0.0f;
-    cellData_[2 * std::size_t(c) + 1] = float(speed);
+    // Eq. (10), once per cell instead of once per tracer: it depends on the cell only. Both models
+    // give 0 in a cell without tracers, where no tracer reads it either.
+    const float alphaTracer = model ? ctx.tracerAlpha[std::size_t(c)] : 0.0f;
+    cellData_[2 * std::size_t(c) + 1] =
+        alphaTracer > 0.0f
+            ? float(std::min(model->speed(alphaTracer, sampler.alphaP(c), settings_.d0, dt), settings_.uFlucMax))
+            : 0.0f;
   }
 }
 
@@ -162,9 +168,9 @@ void MotionKernel::move(TracerContext& ctx) {
   std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0, scalarPath = 0, exactWallTests = 0;
   // Sub-steps so that no sub-step moves farther than max_courant cells; a non-finite or enormous
   // displacement gets kMaxSubsteps (the exact wall tests still keep the tracer inside).
-  const double cellLimit = settings_.maxCourant * minSpacing_;
-  auto substepsFor = [cellLimit](double distance, std::int64_t& cappedCount) -> int {
-    const double courant = distance / cellLimit;
+  const double inverseCellLimit = 1.0 / (settings_.maxCourant * minSpacing_);
+  auto substepsFor = [inverseCellLimit](double distance, std::int64_t& cappedCount) -> int {
+    const double courant = distance * inverseCellLimit;
     if (!(courant <= double(kMaxSubsteps))) {
       ++cappedCount;
       return kMaxSubsteps;
@@ -181,6 +187,8 @@ void MotionKernel::move(TracerContext& ctx) {
   bc.reynoldsPerSpeed = reynoldsPerSpeed_;
   for (int d = 0; d < 3; ++d) bc.gravity[d] = gravity_[d];
   bc.restitution = settings_.wallRestitution;
+  static_assert(Context::kMaxSubsteps == kMaxSubsteps);
+  for (int k = 1; k <= kMaxSubsteps; ++k) bc.substepLength[k] = dt / k;  // the scalar path's h = dt / nsub
   bc.cellData = cellData_.data();
   bc.plateReach = plateReach_.empty() ? nullptr : plateReach_.data();
   bc.q = locator.constants();
@@ -322,16 +330,9 @@ void MotionKernel::move(TracerContext& ctx) {
       locateBlock(bc.q, m, L.x, L.y, L.z, stencils, nullptr);
       gatherBlock(bc.field, bc.corner4, m, stencils);
       interpolateBlock(stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
-      alignas(64) std::int32_t over[kBlock];
       auto countSubsteps = [&](Lanes& lanes) {
-        substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, cellLimit, lanes.h, lanes.left, over,
-                        double(kMaxSubsteps));
-        std::int32_t maxLeft = 0;
-        for (int k = 0; k < lanes.count; ++k) {
-          st.substeps += lanes.left[k], st.substepCapped += over[k];
-          maxLeft = std::max(maxLeft, lanes.left[k]);
-        }
-        return maxLeft;
+        return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
+                               double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);
       };
       advanceLanes(L, countSubsteps(L), stencils, false, bc, st);
       if (freeLanes > 0) {
