@@ -5,6 +5,7 @@
 /// and the open fraction of the mid-plane cell (which shows where the walls cut the grid). Used to
 /// tell an annulus value from a spout-edge or wall-cell value (docs/database.md).
 
+#include <string>
 #include <vector>
 
 #include "fields/FieldDatabase.hpp"
@@ -28,5 +29,10 @@ struct AlphaProfile {
 /// [m]; heights outside the grid are skipped.
 std::vector<AlphaProfile> alphaProfiles(const Scene& scene, const FieldDatabase& db, const std::vector<double>& alpha,
                                         const std::vector<double>& heights);
+
+/// Draws the profiles (alpha_P on the mid-plane against x, one line per height, cut wall cells
+/// marked, a dashed line at alpha_P = 0.5) as database_alpha_p_profiles.svg in outDir; returns the
+/// file name.
+std::string writeAlphaProfileFigure(const std::vector<AlphaProfile>& profiles, const std::string& outDir);
 
 }  // namespace rcfd::analysis

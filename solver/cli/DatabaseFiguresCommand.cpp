@@ -73,7 +73,9 @@ int run(const Options& o) {
   out["probes"] = probes;
   if (!o.profileHeights.empty()) {
     nlohmann::json profiles = nlohmann::json::array();
-    for (const auto& p : analysis::alphaProfiles(scene, *db, mean, o.profileHeights)) {
+    const auto rows = analysis::alphaProfiles(scene, *db, mean, o.profileHeights);
+    out["figures"].push_back(analysis::writeAlphaProfileFigure(rows, o.out));
+    for (const auto& p : rows) {
       nlohmann::json cells = nlohmann::json::array();
       for (const auto& c : p.cells)
         cells.push_back({{"x", c.x}, {"alpha_p_mid", c.alphaMid}, {"alpha_p_depth", c.alphaDepth}, {"open_mid", c.openMid}});

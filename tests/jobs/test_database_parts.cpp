@@ -301,4 +301,12 @@ TEST(AlphaProfiles, MidPlaneAndOpenVolumeWeightedDepthMeanAcrossX) {
   EXPECT_DOUBLE_EQ(cells[0].openMid, 1.0);
   EXPECT_NEAR(cells[4].alphaMid, 0.35, 1e-12);    // column i = 5
   EXPECT_NEAR(cells[4].alphaDepth, 0.30, 1e-12);  // the plain mean of 0.15 .. 0.45
+  const fs::path dir = fs::temp_directory_path() / ("alpha-profiles-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  EXPECT_EQ(rcfd::analysis::writeAlphaProfileFigure(profiles, dir.string()), "database_alpha_p_profiles.svg");
+  std::stringstream svg;
+  svg << std::ifstream(dir / "database_alpha_p_profiles.svg").rdbuf();
+  EXPECT_NE(svg.str().find("<polyline"), std::string::npos);
+  EXPECT_NE(svg.str().find("y = 0.1050 m"), std::string::npos);
+  fs::remove_all(dir);
 }
