@@ -56,7 +56,7 @@ double bedSolidFraction(const DemParticles& p, double area, double y0, double y1
 // 0.7 s (1 m/s^2: halving the rate moves U_mf by 1%, docs/physics.md). The packed-bed branch is the
 // part of the decreasing curve after the pressure drop last exceeded 0.9 W/A and below 0.75 W/A.
 // RCFD_FLUID_CSV=FILE writes the (t, U, dp) series; RCFD_FLUID_* change the protocol (see envOr).
-// U_mf = 1.14-1.19 Wen-Yu over seeds and rates (docs/physics.md "Minimum fluidisation"); 16 s on one
+// U_mf = 1.14-1.19 Wen-Yu over seeds and rates (docs/physics.md "Minimum fluidisation"); 16-19 s on one
 // core. The slugging bed is chaotic: a rounding-level change of the run moves the ratio by ~0.02.
 TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
   const double width = envOr("RCFD_FLUID_WIDTH", 0.05);
