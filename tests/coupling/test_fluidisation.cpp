@@ -53,7 +53,7 @@ double bedSolidFraction(const DemParticles& p, double area, double y0, double y1
 // A 5 cm x 5 cm box (14 parcel diameters), cg 2 parcels of 3.6 mm in 5 mm cells as in quick.json, a
 // bed of 1570 parcels poured and settled (DEM only, as in the database job), about 2.6 cm high. The
 // gas rises to 0.9 m/s (1.6 Wen-Yu) in 0.2 s, stays 0.15 s (the bed slugs), and falls to 0.2 m/s in
-// 0.7 s (1 m/s^2: halving the rate moves U_mf by 1%, docs/physics.md). The packed-bed branch is the
+// 0.7 s (1 m/s^2: halving the rate moves U_mf by 1-3%, docs/physics.md). The packed-bed branch is the
 // part of the decreasing curve after the pressure drop last exceeded 0.9 W/A and below 0.75 W/A.
 // RCFD_FLUID_CSV=FILE writes the (t, U, dp) series; RCFD_FLUID_* change the protocol (see envOr).
 // U_mf = 1.14-1.19 Wen-Yu over seeds and rates (docs/physics.md "Minimum fluidisation"); 16-19 s on one
