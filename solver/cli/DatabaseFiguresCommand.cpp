@@ -2,7 +2,8 @@
 // (analysis/DatabaseFigures.hpp) for any field database that carries its scene: alpha_P on the
 // mid-plane at four instants and averaged over all frames, and the pressure-drop series when the file
 // (/reference/pressure_drop/pa) or a database job's checkpoint holds one. Prints the time-averaged
-// alpha_P at the scene's probes as JSON. Useful for a database of an interrupted job or of another
+// alpha_P at the scene's probes as JSON, and with --profiles Y1,Y2,.. its profiles across x at those
+// heights (analysis/AlphaProfiles.hpp). Useful for a database of an interrupted job or of another
 // program.
 
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "analysis/AlphaProfiles.hpp"
 #include "analysis/DatabaseFigures.hpp"
 #include "analysis/SeriesSpectrum.hpp"
 #include "cfddem/ReferenceRecorder.hpp"
@@ -30,6 +32,7 @@ struct Options {
   std::string database;
   std::string out = ".";
   std::string checkpoint;
+  std::vector<double> profileHeights;  ///< [m]
 };
 
 /// The pressure-drop series of the database or, failing that, of a database job's checkpoint (its
@@ -68,6 +71,18 @@ int run(const Options& o) {
     probes.push_back({{"name", p.name}, {"alpha_p_mean", mean[std::size_t(db->grid().flatIndexOf(p.position))]}});
   }
   out["probes"] = probes;
+  if (!o.profileHeights.empty()) {
+    nlohmann::json profiles = nlohmann::json::array();
+    const auto rows = analysis::alphaProfiles(scene, *db, mean, o.profileHeights);
+    out["figures"].push_back(analysis::writeAlphaProfileFigure(rows, o.out));
+    for (const auto& p : rows) {
+      nlohmann::json cells = nlohmann::json::array();
+      for (const auto& c : p.cells)
+        cells.push_back({{"x", c.x}, {"alpha_p_mid", c.alphaMid}, {"alpha_p_depth", c.alphaDepth}, {"open_mid", c.openMid}});
+      profiles.push_back({{"y", p.y}, {"cells", cells}});
+    }
+    out["profiles"] = profiles;
+  }
   std::cout << out.dump(2) << "\n";
   return exit_code::success;
 }
@@ -80,6 +95,9 @@ const bool registered = addCommand(
       app.add_option("--out", o->out, "directory for the SVG files (default .)");
       app.add_option("--checkpoint", o->checkpoint,
                      "a database job's checkpoint.h5: the pressure drop recorded so far, when the database has none");
+      app.add_option("--profiles", o->profileHeights,
+                     "heights [m] (comma-separated) at which to print the time-averaged alpha_P across x")
+          ->delimiter(',');
       return [o] { return run(*o); };
     });
 

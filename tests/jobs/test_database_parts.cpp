@@ -12,6 +12,7 @@
 #include <random>
 #include <sstream>
 
+#include "analysis/AlphaProfiles.hpp"
 #include "analysis/DatabaseFigures.hpp"
 #include "analysis/SeriesSpectrum.hpp"
 #include "analysis/ZoneStays.hpp"
@@ -267,5 +268,45 @@ TEST(DatabaseFigures, SnapshotsTimeAverageAndPressureDrop) {
   EXPECT_NE(a.str().find("t = 0.040 s"), std::string::npos);  // the last snapshot, frame 8
   EXPECT_NE(b.str().find("2.50 Hz"), std::string::npos);
   EXPECT_NE(b.str().find("<polyline"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(AlphaProfiles, MidPlaneAndOpenVolumeWeightedDepthMeanAcrossX) {
+  const rcfd::Scene scene = rcfd::loadScene(boxScene());
+  const rcfd::Apparatus box(scene.apparatus);
+  const rcfd::CartesianGrid grid = rcfd::makeGrid(box, scene.grid);
+  ASSERT_EQ(grid.shape[2], 4);
+  // Column i = 0 closed on the mid-plane layer (k = 2): not in the profile; column i = 1 half open
+  // in its first layer: weighted by it in the depth mean.
+  std::vector<float> fluid(std::size_t(grid.cellCount()), 1.0f);
+  for (int j = 0; j < grid.shape[1]; ++j) {
+    fluid[std::size_t(grid.flatIndex(0, j, 2))] = 0.0f;
+    fluid[std::size_t(grid.flatIndex(1, j, 0))] = 0.5f;
+  }
+  auto db = rcfd::makeAnalyticDatabase(grid, fluid, 0.005, 3, [](int, double, rcfd::FieldFrame&) {});
+  std::vector<double> alpha(std::size_t(grid.cellCount()));
+  for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+    const auto ijk = grid.cellIjk(c);
+    alpha[std::size_t(c)] = 0.1 * (ijk[2] + 1) + 0.01 * ijk[0];
+  }
+  const double y = grid.cellCenter(0, 10, 0).y();
+  const auto profiles = rcfd::analysis::alphaProfiles(scene, *db, alpha, {y + 0.002, 10.0});
+  ASSERT_EQ(profiles.size(), 1u);  // 10 m is above the grid
+  EXPECT_DOUBLE_EQ(profiles[0].y, y);
+  const auto& cells = profiles[0].cells;
+  ASSERT_EQ(int(cells.size()), grid.shape[0] - 1);
+  EXPECT_DOUBLE_EQ(cells[0].x, grid.cellCenter(1, 10, 2).x());
+  EXPECT_NEAR(cells[0].alphaMid, 0.31, 1e-12);
+  EXPECT_NEAR(cells[0].alphaDepth, (0.5 * 0.11 + 0.21 + 0.31 + 0.41) / 3.5, 1e-12);
+  EXPECT_DOUBLE_EQ(cells[0].openMid, 1.0);
+  EXPECT_NEAR(cells[4].alphaMid, 0.35, 1e-12);    // column i = 5
+  EXPECT_NEAR(cells[4].alphaDepth, 0.30, 1e-12);  // the plain mean of 0.15 .. 0.45
+  const fs::path dir = fs::temp_directory_path() / ("alpha-profiles-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  EXPECT_EQ(rcfd::analysis::writeAlphaProfileFigure(profiles, dir.string()), "database_alpha_p_profiles.svg");
+  std::stringstream svg;
+  svg << std::ifstream(dir / "database_alpha_p_profiles.svg").rdbuf();
+  EXPECT_NE(svg.str().find("<polyline"), std::string::npos);
+  EXPECT_NE(svg.str().find("y = 0.1050 m"), std::string::npos);
   fs::remove_all(dir);
 }
