@@ -97,10 +97,13 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
 #pragma omp simd
     for (int k = 0; k < m; ++k) fast[k] |= inside[k];
   }
-#pragma omp simd
+  std::int64_t exact = 0;
+#pragma omp simd reduction(+ : exact)
   for (int k = 0; k < m; ++k) {
     if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];  // masked stores
+    exact += 1 - fast[k];
   }
+  if (exact == 0) return;  // most blocks: no lane near enough a wall to need the exact test
   // The rest meet a wall or pass close to one: the exact segment test and mirror reflection, which
   // for a free-flying tracer also reflects its velocity with the restitution coefficient.
   for (int k = 0; k < m; ++k) {
