@@ -158,6 +158,15 @@ TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
   EXPECT_TRUE(s["pressure_drop"]["dominant_frequency_hz"].is_null());
   for (const char* key : {"mean_s", "median_s", "histogram"}) EXPECT_TRUE(s["residence_time"].contains(key));
   EXPECT_TRUE(s["holdup"].contains("mean"));
+  // Blow-out: a settled DEM-only bed of 340 parcels in a 0.1 m box stays at the bottom: its highest
+  // parcel top lies a few centimetres up, and reaching the top between two 1 ms samples would take
+  // tens of m/s.
+  const json& blow = s["blow_out"];
+  EXPECT_DOUBLE_EQ(blow["chamber_top_m"].get<double>(), 0.1);
+  EXPECT_GT(blow["highest_parcel_top_m"].get<double>(), kParcelDiameter);
+  EXPECT_LT(blow["highest_parcel_top_m"].get<double>(), 0.05);
+  EXPECT_DOUBLE_EQ(blow["sample_interval_s"].get<double>(), 1e-3);
+  EXPECT_GT(blow["speed_to_reach_top_m_per_s"].get<double>(), 10.0);
   EXPECT_FALSE(fs::exists(dir_ / "a" / "checkpoint.h5"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "result.h5"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "database_alpha_p.svg"));
