@@ -40,6 +40,11 @@ class ZoneStays {
   explicit ZoneStays(std::size_t members = 0) : entry_(members, kOutside) {}
 
   std::size_t members() const { return entry_.size(); }
+  /// Whether member i is inside now (its stay is open): observe() changes nothing unless `inside`
+  /// differs from this, which lets callers skip the members that neither entered nor left.
+  bool isInside(std::size_t i) const { return entry_[i] != kOutside; }
+  /// entry_ as an array, for loops that test isInside() for many members at once.
+  const std::int64_t* entries() const { return entry_.data(); }
 
   /// Member i is inside at the start: its stay has no known entry and is never counted.
   void startInside(std::size_t i) { entry_[i] = kUnknownEntry; }

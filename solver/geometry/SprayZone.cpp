@@ -71,13 +71,6 @@ double SprayZone::radiusAt(double y) const {
   return y <= spec_.apex.y() ? 0.0 : (y - spec_.apex.y()) * tanHalfAngle_;
 }
 
-bool SprayZone::contains(const Eigen::Vector3d& p) const {
-  if (p.y() < spec_.y_min || p.y() > spec_.y_max) return false;
-  const double dx = p.x() - spec_.apex.x(), dz = p.z() - spec_.apex.z();
-  const double r = radiusAt(p.y());
-  return dx * dx + dz * dz <= r * r;
-}
-
 double SprayZone::volume() const {
   const double h1 = spec_.y_max - spec_.apex.y(), h0 = spec_.y_min - spec_.apex.y();
   return std::numbers::pi * tanHalfAngle_ * tanHalfAngle_ / 3.0 * (h1 * h1 * h1 - h0 * h0 * h0);

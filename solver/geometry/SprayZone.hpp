@@ -21,7 +21,14 @@ class SprayZone {
   const SprayZoneSpec& spec() const { return spec_; }
 
   /// True if p lies in the truncated cone (boundary included).
-  bool contains(const Eigen::Vector3d& p) const;
+  bool contains(const Eigen::Vector3d& p) const { return contains(p.x(), p.y(), p.z()); }
+  /// The same test on coordinates, branch-free, so loops over many points vectorise.
+  bool contains(double x, double y, double z) const {
+    const double dx = x - spec_.apex.x(), dz = z - spec_.apex.z();
+    const double above = y - spec_.apex.y();
+    const double r = (above > 0.0 ? above : 0.0) * tanHalfAngle_;  // radiusAt(y)
+    return (y >= spec_.y_min) & (y <= spec_.y_max) & (dx * dx + dz * dz <= r * r);
+  }
 
   /// Radius of the cone's cross-section at height y, (y - apex.y) tan(half-angle) [m]; 0 below the apex.
   double radiusAt(double y) const;

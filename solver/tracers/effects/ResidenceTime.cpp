@@ -30,17 +30,37 @@ class ResidenceTimeEffect final : public TracerEffect {
     const std::int64_t n = std::int64_t(stays_.members());
     const std::int64_t step = ctx.step;
     const std::int64_t discard = ctx.discardSteps;
+    const double* x = ctx.cloud.x.data();
+    const double* y = ctx.cloud.y.data();
+    const double* z = ctx.cloud.z.data();
+    const std::int64_t* entry = stays_.entries();
+    constexpr std::int64_t kOutside = ZoneStays::kOutside;
+    constexpr std::int64_t kBlock = 256;
     std::int64_t inside = 0;
     std::vector<std::int64_t> finished;  // durations in steps of stays ending now
 #pragma omp parallel if (n > kParallelThreshold)
     {
       std::vector<std::int64_t> local;
 #pragma omp for schedule(static) reduction(+ : inside)
-      for (std::int64_t i = 0; i < n; ++i) {
-        const bool in = zone_.contains(ctx.cloud.position(std::size_t(i)));
-        inside += in;
-        const std::int64_t d = stays_.observe(std::size_t(i), in, step, discard);
-        if (d >= 0) local.push_back(d);
+      for (std::int64_t b = 0; b < (n + kBlock - 1) / kBlock; ++b) {
+        const std::int64_t i0 = b * kBlock;
+        const int count = int(std::min(kBlock, n - i0));
+        // Who is inside, and who entered or left (few): only those change the books.
+        std::int64_t in[kBlock], changed[kBlock];
+        std::int64_t insideHere = 0, changes = 0;
+#pragma omp simd reduction(+ : insideHere, changes)
+        for (int k = 0; k < count; ++k) {
+          in[k] = zone_.contains(x[i0 + k], y[i0 + k], z[i0 + k]);
+          changed[k] = in[k] != std::int64_t(entry[i0 + k] != kOutside);
+          insideHere += in[k], changes += changed[k];
+        }
+        inside += insideHere;
+        if (changes == 0) continue;
+        for (int k = 0; k < count; ++k) {
+          if (!changed[k]) continue;
+          const std::int64_t d = stays_.observe(std::size_t(i0 + k), in[k] != 0, step, discard);
+          if (d >= 0) local.push_back(d);
+        }
       }
 #pragma omp critical
       finished.insert(finished.end(), local.begin(), local.end());
