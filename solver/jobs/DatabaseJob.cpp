@@ -9,6 +9,7 @@
 // Checkpoints (DIR/checkpoint.h5, every checkpoint_interval and on cancellation) hold the simulation
 // state and the job's counters; a resumed job cuts database.h5 back to the frames sampled before the
 // checkpoint and goes on from there, so it writes what an uninterrupted job writes.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -70,6 +71,10 @@ struct JobState {
   /// Highest parcel top (y + r) seen at the reference samples [m]; the DEM's outlet is a wall, so
   /// this is how the job tells that no parcel came near blowing out.
   double highestParcelTop = -std::numeric_limits<double>::infinity();
+  double highestParcelTime = 0.0;  ///< when it was seen [s]
+  /// Per parcel, 1 once its top came within one parcel diameter of the chamber top at a sample: the
+  /// parcels an open outlet could have lost.
+  std::vector<std::int64_t> reachedTop;
   FillResult fill;
 };
 
@@ -103,6 +108,7 @@ class DatabaseJob final : public JobRunner {
       spdlog::info("resumed from {} at t = {:.4f} s, {} frames kept", checkpoint, sim.time(), st.framesWritten);
     }
 
+    const double chamberTop = sim.apparatus().upperCorner().y();
     const double total = scene.dem.settle_time + double(plan.endOffset()) * plan.dtDem;
     auto fraction = [&] {
       if (!st.settled) return 0.0;
@@ -159,8 +165,12 @@ class DatabaseJob final : public JobRunner {
       if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {
         rec->record(sim.particleVelocity(), sim.pressureDrop(), sim.dem().particles());
         const DemParticles& p = sim.dem().particles();
-        for (std::size_t i = 0; i < p.size(); ++i)
-          st.highestParcelTop = std::max(st.highestParcelTop, p.x[i].y() + p.radius[i]);
+        st.reachedTop.resize(p.size(), 0);
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          const double top = p.x[i].y() + p.radius[i];
+          if (top > st.highestParcelTop) st.highestParcelTop = top, st.highestParcelTime = sim.time();
+          if (top >= chamberTop - 2.0 * p.radius[i]) st.reachedTop[i] = 1;
+        }
       }
       if (st.framesWritten >= plan.frames && rec->samples() >= totalSamples) break;
       std::int64_t next = plan.sampleOffset(rec->samples());
@@ -217,11 +227,14 @@ class DatabaseJob final : public JobRunner {
     // Blow-out: the DEM keeps parcels in with a wall at the outlet, so report how close they came. A
     // parcel that reached the top between two samples (1 / probe_rate apart) would have had to cover
     // the gap in that time.
-    const double top = sim.apparatus().upperCorner().y();
+    const std::int64_t nearTop = std::count(st.reachedTop.begin(), st.reachedTop.end(), std::int64_t(1));
     summary["blow_out"] = {{"highest_parcel_top_m", st.highestParcelTop},
-                           {"chamber_top_m", top},
+                           {"highest_parcel_time_s", st.highestParcelTime},
+                           {"chamber_top_m", chamberTop},
                            {"sample_interval_s", plan.sampleDt()},
-                           {"speed_to_reach_top_m_per_s", (top - st.highestParcelTop) / plan.sampleDt()}};
+                           {"speed_to_reach_top_m_per_s", (chamberTop - st.highestParcelTop) / plan.sampleDt()},
+                           {"parcels_reaching_top", nearTop},
+                           {"fraction_reaching_top", double(nearTop) / double(std::max<std::size_t>(1, parcels))}};
     writeResultAndFigures(scene, databasePath, options.outDir, *rec, summary);
     // Wall time and rates describe this machine, not the physics: the only keys allowed to differ
     // between otherwise bit-identical runs.
@@ -244,7 +257,8 @@ class DatabaseJob final : public JobRunner {
                                                          st.fill.settled});
       f.write("/job/times", std::vector<double>{st.wallTime, st.fill.fill_time, st.fill.settle_time,
                                                 st.fill.kinetic_energy});
-      f.write("/job/highest_parcel_top", std::vector<double>{st.highestParcelTop});
+      f.write("/job/highest_parcel_top", std::vector<double>{st.highestParcelTop, st.highestParcelTime});
+      f.write("/job/reached_top", st.reachedTop);
       sim.saveState(f, "/simulation");
       if (rec) rec->save(f, "/reference");
       f.flush();
@@ -271,7 +285,12 @@ class DatabaseJob final : public JobRunner {
     st.fill.fill_time = t.at(1);
     st.fill.settle_time = t.at(2);
     st.fill.kinetic_energy = t.at(3);
-    if (f.exists("/job/highest_parcel_top")) st.highestParcelTop = f.readDoubles("/job/highest_parcel_top").at(0);
+    if (f.exists("/job/highest_parcel_top")) {
+      const auto h = f.readDoubles("/job/highest_parcel_top");
+      st.highestParcelTop = h.at(0);
+      st.highestParcelTime = h.size() > 1 ? h[1] : 0.0;
+      if (f.exists("/job/reached_top")) st.reachedTop = f.readInt64s("/job/reached_top");
+    }
     sim.loadState(f, "/simulation");
   }
 

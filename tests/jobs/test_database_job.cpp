@@ -167,6 +167,8 @@ TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
   EXPECT_LT(blow["highest_parcel_top_m"].get<double>(), 0.05);
   EXPECT_DOUBLE_EQ(blow["sample_interval_s"].get<double>(), 1e-3);
   EXPECT_GT(blow["speed_to_reach_top_m_per_s"].get<double>(), 10.0);
+  EXPECT_EQ(blow["parcels_reaching_top"].get<int>(), 0);
+  EXPECT_EQ(blow["fraction_reaching_top"].get<double>(), 0.0);
   EXPECT_FALSE(fs::exists(dir_ / "a" / "checkpoint.h5"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "result.h5"));
   EXPECT_TRUE(fs::exists(dir_ / "a" / "database_alpha_p.svg"));
