@@ -57,6 +57,7 @@ struct Timing {
   double wallHitFraction = 0.0;    ///< reflections per tracer-step (last step)
   double scalarFraction = 0.0;     ///< tracers that took the kernel's scalar path (last step)
   double wallTestFraction = 0.0;   ///< block-path tracers that needed the exact wall test (last step)
+  double freeFlightFraction = 0.0; ///< tracers in free flight (last step)
 };
 
 template <class AfterRun = void (*)(TracerSimulation&)>
@@ -89,6 +90,7 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
   t.wallHitFraction = double(sim.motionStatistics().wallHits) / double(scene.rcfd.tracers);
   t.scalarFraction = double(sim.motionStatistics().scalarPath) / double(scene.rcfd.tracers);
   t.wallTestFraction = double(sim.motionStatistics().exactWallTests) / double(scene.rcfd.tracers);
+  t.freeFlightFraction = double(sim.motionStatistics().freeFlight) / double(scene.rcfd.tracers);
   after(sim);
   return t;
 }

@@ -55,9 +55,12 @@ nlohmann::json runTracers(const Options& options) {
     const Timing t = timeRun(variant, db, 1, steps);
     costs[label] = {{"ms_per_step", t.secondsPerStep * 1e3},
                     {"cpu_ms_per_step", t.cpuSecondsPerStep * 1e3},
-                    {"tracer_steps_per_s", t.tracerStepsPerSecond}};
+                    {"tracer_steps_per_s", t.tracerStepsPerSecond},
+                    {"free_flight_fraction", t.freeFlightFraction}};
     std::cerr << label << ": " << t.secondsPerStep * 1e3 << " ms/step, " << t.cpuSecondsPerStep * 1e3
-              << " CPU-ms/step\n";
+              << " CPU-ms/step";
+    if (t.freeFlightFraction > 0.0) std::cerr << " (" << t.freeFlightFraction << " of the tracers in free flight)";
+    std::cerr << "\n";
   }
   return {{"tracer_steps_per_s", headline.tracerStepsPerSecond},
           {"ms_per_step", headline.secondsPerStep * 1e3},

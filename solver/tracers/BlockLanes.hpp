@@ -51,7 +51,7 @@ struct Context {
   double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
   static constexpr int kMaxSubsteps = 64;  ///< MotionKernel::kMaxSubsteps
   double substepLength[kMaxSubsteps + 1] = {};  ///< [n] = dt / n [s]
-  double stokesTime = 0.0;          ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
+  double inverseStokesTime = 0.0;   ///< 18 rho_G nu_G / (rho_P d_P^2) [1/s]
   double reynoldsPerSpeed = 0.0;    ///< d_P / nu_G [s/m]
   double gravity[3] = {};           ///< [m/s2]
   double restitution = 1.0;         ///< normal restitution of free-flying tracers at walls [-]

@@ -24,7 +24,7 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
   const auto& p = ctx.scene.particles;
   const auto& g = ctx.scene.gas;
   reynoldsPerSpeed_ = p.diameter / g.kinematic_viscosity;
-  stokesTime_ = p.density * p.diameter * p.diameter / (18.0 * g.density * g.kinematic_viscosity);
+  inverseStokesTime_ = 18.0 * g.density * g.kinematic_viscosity / (p.density * p.diameter * p.diameter);
   if (settings_.walls) {
     // A point of cell c lies at most half a diagonal from its centre, so its wall distance is at least
     // sd(centre) - halfDiagonal: a move shorter than that cannot reach a wall (the fast path).
@@ -183,7 +183,7 @@ void MotionKernel::move(TracerContext& ctx) {
   Context bc;
   bc.field = particleVelocity_.floats();
   bc.gasField = settings_.freeFlight ? gasVelocity_.floats() : nullptr;
-  bc.stokesTime = stokesTime_;
+  bc.inverseStokesTime = inverseStokesTime_;
   bc.reynoldsPerSpeed = reynoldsPerSpeed_;
   for (int d = 0; d < 3; ++d) bc.gravity[d] = gravity_[d];
   bc.restitution = settings_.wallRestitution;
@@ -226,8 +226,10 @@ void MotionKernel::move(TracerContext& ctx) {
       for (int s = 0; s < nsub; ++s) {
         const Eigen::Vector3d ug = gas.sample(p);
         const double re = (ug - v).norm() * reynoldsPerSpeed_;
-        const double tau = stokesTime_ / singleSphereDragFactor(re);
-        v = (v + h * (ug / tau + gravity_)) / (1.0 + h / tau);
+        // Implicit in the drag: v' = (v + h (u_G / tau + g)) / (1 + h / tau), with 1 / tau = f / tau_Stokes.
+        const double inverseTau = singleSphereDragFactor(re) * inverseStokesTime_;
+        const double relaxation = 1.0 / (1.0 + h * inverseTau);
+        v = (v + h * (ug * inverseTau + gravity_)) * relaxation;
         st.wallHits += moveWithWalls(p, h * v, &v, settings_.wallRestitution, s == 0 ? firstClearance : -1.0);
       }
       st.substeps += nsub - 1;

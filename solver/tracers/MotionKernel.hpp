@@ -72,7 +72,7 @@ class MotionKernel {
   std::vector<float> plateReach_; ///< draft-plate distance of each cell centre less the band [m] (plates only)
   std::vector<Apparatus::HalfSpace> halfSpaces_;  ///< the open region's convex part
   double minSpacing_;
-  double stokesTime_;             ///< rho_P d_P^2 / (18 rho_G nu_G) [s]
+  double inverseStokesTime_;      ///< 18 rho_G nu_G / (rho_P d_P^2) [1/s]
   double reynoldsPerSpeed_;       ///< d_P / nu_G [s/m]
   Eigen::Vector3d gravity_{0.0, -9.81, 0.0};
   MotionStatistics stats_;

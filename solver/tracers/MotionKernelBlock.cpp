@@ -132,17 +132,17 @@ void MotionKernel::freeFlightSubStep(block::Lanes& F, block::BlockStencils& s, c
   double* const vy = F.uy;
   double* const vz = F.uz;
   const double* const h = F.h;
-  const double stokesTime = bc.stokesTime, rePerSpeed = bc.reynoldsPerSpeed;
+  const double inverseStokesTime = bc.inverseStokesTime, rePerSpeed = bc.reynoldsPerSpeed;
   const double g0 = bc.gravity[0], g1 = bc.gravity[1], g2 = bc.gravity[2];
 #pragma omp simd
   for (int k = 0; k < m; ++k) {
     const double dx = gx[k] - vx[k], dy = gy[k] - vy[k], dz = gz[k] - vz[k];
     const double re = std::sqrt(dx * dx + dy * dy + dz * dz) * rePerSpeed;
-    const double tau = stokesTime / singleSphereDragFactor(re);
-    const double denominator = 1.0 + h[k] / tau;
-    vx[k] = (vx[k] + h[k] * (gx[k] / tau + g0)) / denominator;
-    vy[k] = (vy[k] + h[k] * (gy[k] / tau + g1)) / denominator;
-    vz[k] = (vz[k] + h[k] * (gz[k] / tau + g2)) / denominator;
+    const double inverseTau = singleSphereDragFactor(re) * inverseStokesTime;  // one division per lane:
+    const double relaxation = 1.0 / (1.0 + h[k] * inverseTau);                 // the scalar path's order
+    vx[k] = (vx[k] + h[k] * (gx[k] * inverseTau + g0)) * relaxation;
+    vy[k] = (vy[k] + h[k] * (gy[k] * inverseTau + g1)) * relaxation;
+    vz[k] = (vz[k] + h[k] * (gz[k] * inverseTau + g2)) * relaxation;
   }
   moveLanes(F, bc, st, true);
 }
