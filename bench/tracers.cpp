@@ -1,6 +1,9 @@
 // rcfd-bench tracers: the tracer step at paper scale -- 472,850 tracers in the ProCell apparatus on a
 // grid of about 73,647 cells, synthetic pseudo-periodic fields (a swaying spout), effects transport +
-// fluctuation + walls + tracer_volume_fraction. Also the cost of each effect added on its own.
+// fluctuation + walls + tracer_volume_fraction. Also the cost of each effect added on its own, and of
+// the Euler integrator. Environment, for A/B runs: RCFD_BENCH_TRACERS_HEADLINE_ONLY=1 (headline only),
+// RCFD_BENCH_INTEGRATOR and RCFD_BENCH_EFFECTS=a,b,.. (override the headline's), RCFD_BENCH_SHUFFLE=1
+// (tracers in random order, as after a long run), RCFD_BENCH_SCALAR_KERNEL=1 (no block path).
 #include <cstdlib>
 #include <iostream>
 
