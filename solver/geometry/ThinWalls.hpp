@@ -5,7 +5,7 @@
 /// cells (openFractions) but meets no face, so per-cell open fractions alone let gas, mapped particle
 /// volume and smoothing pass straight through it. As CFD codes do with baffles (OpenFOAM's
 /// createBaffles turns internal faces into wall faces on both sides), such a plate is snapped to the
-/// grid face nearest to its mid-plane (ties go to the lower face) and covers that face over its extent
+/// grid face nearest to its mid-plane (an exact tie goes to the lower face) and covers that face over its extent
 /// along the other axis. Plates that contain a face already close it (FaceApertures), so they give no
 /// baffle here. The plates span the whole depth: baffles are x- and y-faces only.
 

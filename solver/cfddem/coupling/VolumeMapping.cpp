@@ -34,7 +34,7 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
     w1[a] = n == 1 ? 0.0 : t - i0[a];
   }
   const bool cut = !baffles_.empty();
-  const std::array<int, 3> own = cut ? grid_.cellOf(x) : std::array<int, 3>{};
+  const std::array<int, 3> home = cut ? grid_.cellOf(x) : std::array<int, 3>{};
   double sum = 0.0;
   for (int c = 0; c < 8; ++c) {
     const int o[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
@@ -43,7 +43,7 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
     if (w == 0.0) continue;
     const std::int64_t cell = grid_.flatIndex(i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]);
     if (!usable_[std::size_t(cell)]) continue;
-    if (cut && !reachable(own, {i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]}, 7)) continue;  // behind a plate
+    if (cut && !reachable(home, {i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]}, 7)) continue;  // behind a plate
     w *= phi_[std::size_t(cell)];  // a cut cell takes its open share only
     out.cell[std::size_t(out.count)] = std::int32_t(cell);
     out.w[std::size_t(out.count)] = w;
