@@ -43,7 +43,7 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
     if (w == 0.0) continue;
     const std::int64_t cell = grid_.flatIndex(i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]);
     if (!usable_[std::size_t(cell)]) continue;
-    if (cut && !reachable(home, {i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]}, 7)) continue;  // behind a plate
+    if (cut && !reachable(home, {i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]})) continue;  // behind a plate
     w *= phi_[std::size_t(cell)];  // a cut cell takes its open share only
     out.cell[std::size_t(out.count)] = std::int32_t(cell);
     out.w[std::size_t(out.count)] = w;
@@ -81,26 +81,19 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
   return out;
 }
 
-bool VolumeMapping::reachable(std::array<int, 3> from, const std::array<int, 3>& to, int axes) const {
+bool VolumeMapping::reachable(const std::array<int, 3>& from, const std::array<int, 3>& to) const {
+  // Depth-first over the axes along which from and to still differ (at most 3! paths of 3 steps).
   for (int a = 0; a < 3; ++a) {
-    if (!(axes & (1 << a))) continue;
-    if (from[std::size_t(a)] == to[std::size_t(a)]) {
-      axes &= ~(1 << a);
-      continue;
-    }
-  }
-  if (axes == 0) return true;
-  for (int a = 0; a < 3; ++a) {
-    if (!(axes & (1 << a))) continue;
+    if (from[std::size_t(a)] == to[std::size_t(a)]) continue;
     // The face between from and its neighbour along a carries the larger cell index.
     std::array<int, 3> face = from;
     face[std::size_t(a)] = std::max(from[std::size_t(a)], to[std::size_t(a)]);
     if (baffles_.closes(a, face[0], face[1], face[2])) continue;
     std::array<int, 3> next = from;
     next[std::size_t(a)] = to[std::size_t(a)];
-    if (reachable(next, to, axes & ~(1 << a))) return true;
+    if (reachable(next, to)) return true;
   }
-  return false;
+  return from == to;
 }
 
 void VolumeMapping::weightsOf(const DemParticles& p, std::vector<KernelWeights>& out) const {

@@ -80,7 +80,7 @@ class VolumeMapping {
  private:
   /// Whether cell `to` is reached from cell `from` (indices differing by at most one per axis) by a
   /// path of face steps, one per differing axis in some order, none through a closing baffle face.
-  bool reachable(std::array<int, 3> from, const std::array<int, 3>& to, int axes) const;
+  bool reachable(const std::array<int, 3>& from, const std::array<int, 3>& to) const;
 
   CartesianGrid grid_;
   std::vector<double> phi_;
