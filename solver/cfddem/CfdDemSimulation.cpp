@@ -13,6 +13,7 @@
 #include "cfddem/gas/GasSolver.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
+#include "geometry/ThinWalls.hpp"
 
 namespace rcfd {
 
@@ -46,7 +47,8 @@ CfdDemSimulation::CfdDemSimulation(const Scene& scene, std::uint64_t seed, const
     std::vector<double> phi = openFractions(*apparatus_, grid_);
     std::vector<char> usable(phi.size());
     for (std::size_t c = 0; c < phi.size(); ++c) usable[c] = phi[c] > 0 ? 1 : 0;
-    coupling_->mapping = std::make_unique<coupling::VolumeMapping>(grid_, std::move(phi), std::move(usable));
+    coupling_->mapping = std::make_unique<coupling::VolumeMapping>(grid_, std::move(phi), std::move(usable),
+                                                                   thinWallBaffles(*apparatus_, grid_));
   }
 }
 

@@ -32,7 +32,11 @@ TEST(GasProCell, InletAndNozzleCarryTheSceneFlows) {
   EXPECT_NEAR(gas::openSegmentLength(withPlates, {0.0, 0.09}, {0.05, 0.09}), 0.05 - 0.002, 1e-14);
 }
 
-void expectMassConserved(bool plates, const std::string& preconditioner = "mg") {
+/// balance: allowed |net outflow - nozzle flow| relative to the total flow. The sum of the cell residuals
+/// is bounded by the relative L2 stopping test only up to sqrt(cells): multigrid ends with a near
+/// zero-sum residual (1e-14 q), incomplete Cholesky or Jacobi with up to 4e-7 q (IC, draft plates as
+/// baffles, step 3) while every cell meets the tolerance.
+void expectMassConserved(bool plates, const std::string& preconditioner = "mg", double balance = 1e-7) {
   gas::GasOptions o;
   o.preconditioner = preconditioner;
   GasCase c(quickSliceScene(plates), o);
@@ -42,7 +46,7 @@ void expectMassConserved(bool plates, const std::string& preconditioner = "mg") 
     g.step(1.0);
     ASSERT_LE(g.lastStep().divergence.relative, c.scene.gas.pressure_tolerance) << "step " << n;
     // Outflow at the top = slot + nozzle (alpha_G constant: no storage).
-    ASSERT_NEAR(g.netOutflow(), g.nozzleFlow(), 1e-7 * q) << "step " << n;
+    ASSERT_NEAR(g.netOutflow(), g.nozzleFlow(), balance * q) << "step " << n;
   }
   EXPECT_NEAR(g.inletFlow(), c.scene.process.gas_flow_rate, 1e-12);
   // Closed faces carry no velocity.
@@ -56,7 +60,7 @@ void expectMassConserved(bool plates, const std::string& preconditioner = "mg") 
 TEST(GasProCell, MassConservedWithoutPlates) { expectMassConserved(false); }
 TEST(GasProCell, MassConservedWithPlates) { expectMassConserved(true); }
 TEST(GasProCell, MassConservedWithIncompleteCholeskyAndJacobi) {
-  expectMassConserved(true, "ic");
+  expectMassConserved(true, "ic", 1e-6);
   expectMassConserved(false, "jacobi");
 }
 

@@ -21,7 +21,8 @@ FluidCoupling::FluidCoupling(const Scene& scene, gas::GasSolver& gas, DemSystem&
   } catch (const std::out_of_range& e) {
     throw InputError("scene", "/effects", std::string("drag model: ") + e.what());
   }
-  mapping_ = std::make_unique<VolumeMapping>(gas_.grid(), gas_.openFraction(), gas_.activeCells());
+  mapping_ = std::make_unique<VolumeMapping>(gas_.grid(), gas_.openFraction(), gas_.activeCells(),
+                                             gas_.apertures().baffles);
   if (options_.smoothingLength > 0)
     smoother_ = std::make_unique<FieldSmoother>(*mapping_, gas_.faceKinds(0), gas_.faceKinds(1), gas_.faceKinds(2),
                                                 options_.smoothingLength);

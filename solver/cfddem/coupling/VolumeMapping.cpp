@@ -13,8 +13,9 @@ namespace rcfd::coupling {
 /// A cell counts as over-packed above maxFraction (1 + this): the Jacobi sweeps converge geometrically.
 constexpr double kRedistributionTolerance = 1e-9;
 
-VolumeMapping::VolumeMapping(const CartesianGrid& grid, std::vector<double> openFraction, std::vector<char> usable)
-    : grid_(grid), phi_(std::move(openFraction)), usable_(std::move(usable)) {
+VolumeMapping::VolumeMapping(const CartesianGrid& grid, std::vector<double> openFraction, std::vector<char> usable,
+                             BaffleFaces baffles)
+    : grid_(grid), phi_(std::move(openFraction)), usable_(std::move(usable)), baffles_(std::move(baffles)) {
   if (phi_.size() != std::size_t(grid_.cellCount()) || usable_.size() != phi_.size())
     throw RunError("volume mapping: open fractions do not match the grid");
   for (std::size_t c = 0; c < phi_.size(); ++c)
@@ -32,6 +33,8 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
     i0[a] = n == 1 ? 0 : std::min(int(std::floor(t)), n - 2);
     w1[a] = n == 1 ? 0.0 : t - i0[a];
   }
+  const bool cut = !baffles_.empty();
+  const std::array<int, 3> home = cut ? grid_.cellOf(x) : std::array<int, 3>{};
   double sum = 0.0;
   for (int c = 0; c < 8; ++c) {
     const int o[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
@@ -40,6 +43,7 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
     if (w == 0.0) continue;
     const std::int64_t cell = grid_.flatIndex(i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]);
     if (!usable_[std::size_t(cell)]) continue;
+    if (cut && !reachable(home, {i0[0] + o[0], i0[1] + o[1], i0[2] + o[2]})) continue;  // behind a plate
     w *= phi_[std::size_t(cell)];  // a cut cell takes its open share only
     out.cell[std::size_t(out.count)] = std::int32_t(cell);
     out.w[std::size_t(out.count)] = w;
@@ -75,6 +79,21 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
   out.w[0] = 1.0;
   out.count = 1;
   return out;
+}
+
+bool VolumeMapping::reachable(const std::array<int, 3>& from, const std::array<int, 3>& to) const {
+  // Depth-first over the axes along which from and to still differ (at most 3! paths of 3 steps).
+  for (int a = 0; a < 3; ++a) {
+    if (from[std::size_t(a)] == to[std::size_t(a)]) continue;
+    // The face between from and its neighbour along a carries the larger cell index.
+    std::array<int, 3> face = from;
+    face[std::size_t(a)] = std::max(from[std::size_t(a)], to[std::size_t(a)]);
+    if (baffles_.closes(a, face[0], face[1], face[2])) continue;
+    std::array<int, 3> next = from;
+    next[std::size_t(a)] = to[std::size_t(a)];
+    if (reachable(next, to)) return true;
+  }
+  return from == to;
 }
 
 void VolumeMapping::weightsOf(const DemParticles& p, std::vector<KernelWeights>& out) const {
@@ -126,6 +145,9 @@ long VolumeMapping::redistributeExcess(std::vector<double>& volume, double maxFr
           if (q[std::size_t(d)] < 0 || q[std::size_t(d)] >= n[std::size_t(d)]) continue;
           const std::size_t m = std::size_t(grid_.flatIndex(q[0], q[1], q[2]));
           if (!usable_[m]) continue;
+          auto face = ijk;
+          face[std::size_t(d)] = std::max(ijk[std::size_t(d)], q[std::size_t(d)]);
+          if (baffles_.closes(d, face[0], face[1], face[2])) continue;  // nothing crosses a plate
           nb[count++] = m;
           capacity += openVolume(m);
         }

@@ -6,6 +6,8 @@
 /// diameters (quick.json), exact in the total volume (the weights of a parcel sum to one), and never
 /// puts volume into a closed cell. The same weights interpolate cell fields to the parcel, so what a
 /// parcel takes from a cell is what the cell gives (momentum exchange, docs/physics.md "Coupling").
+/// Walls thinner than a cell (baffles, geometry/ThinWalls.hpp) cut the kernel: a cell centre that the
+/// parcel's own cell reaches only through a baffle face gets no weight, so no volume crosses a plate.
 
 #include <Eigen/Core>
 #include <array>
@@ -14,6 +16,7 @@
 
 #include "cfddem/DemParticles.hpp"
 #include "geometry/CartesianGrid.hpp"
+#include "geometry/ThinWalls.hpp"
 
 namespace rcfd::coupling {
 
@@ -33,8 +36,9 @@ inline constexpr double kMaxParticleFraction = 0.7;
 class VolumeMapping {
  public:
   /// openFraction per cell [-]; usable marks the cells that may receive volume (open and, with a gas
-  /// solver, connected to the outlet).
-  VolumeMapping(const CartesianGrid& grid, std::vector<double> openFraction, std::vector<char> usable);
+  /// solver, connected to the outlet); baffles: faces no weight and no excess volume may cross.
+  VolumeMapping(const CartesianGrid& grid, std::vector<double> openFraction, std::vector<char> usable,
+                BaffleFaces baffles = {});
 
   /// Weights of a point. A point whose eight neighbouring centres are all closed goes to the nearest
   /// usable cell of the 3x3x3 block around its own cell; RunError when there is none.
@@ -50,7 +54,7 @@ class VolumeMapping {
   std::vector<double> fractionOf(const std::vector<double>& volume) const;
 
   /// Moves particle volume out of cells above maxFraction of their open volume into their usable face
-  /// neighbours (in proportion to the neighbours' open volume), repeated until no cell is above the
+  /// neighbours not behind a baffle (in proportion to the neighbours' open volume), repeated until no cell is above the
   /// limit (to a relative 1e-9) or maxSweeps; exactly conservative. Returns the number of cells that gave volume.
   long redistributeExcess(std::vector<double>& volume, double maxFraction = kMaxParticleFraction,
                           int maxSweeps = 1000) const;
@@ -69,13 +73,19 @@ class VolumeMapping {
   const CartesianGrid& grid() const { return grid_; }
   const std::vector<double>& openFraction() const { return phi_; }
   const std::vector<char>& usable() const { return usable_; }
+  const BaffleFaces& baffles() const { return baffles_; }
   /// Open volume of cell c, V phi_c [m3].
   double openVolume(std::size_t c) const { return grid_.cellVolume() * phi_[c]; }
 
  private:
+  /// Whether cell `to` is reached from cell `from` (indices differing by at most one per axis) by a
+  /// path of face steps, one per differing axis in some order, none through a closing baffle face.
+  bool reachable(const std::array<int, 3>& from, const std::array<int, 3>& to) const;
+
   CartesianGrid grid_;
   std::vector<double> phi_;
   std::vector<char> usable_;
+  BaffleFaces baffles_;
 };
 
 /// Particle volume of parcel i [m3].

@@ -94,6 +94,7 @@ FaceApertures computeFaceApertures(const Apparatus& apparatus, const CartesianGr
   for (int k = 0; k < n[2]; ++k)
     zFraction[std::size_t(k)] = snap(overlap(o.z() + k * h.z(), o.z() + (k + 1) * h.z(), 0.0, depth) / h.z());
 
+  out.baffles = thinWallBaffles(apparatus, grid);
   // x-faces: vertical segments; y-faces: horizontal segments. One x-y section, repeated along z.
   for (int d = 0; d < 2; ++d) {
     const auto s = out.shape[std::size_t(d)];
@@ -105,7 +106,11 @@ FaceApertures computeFaceApertures(const Apparatus& apparatus, const CartesianGr
         const Vector2d b = d == 0 ? Vector2d(a.x(), a.y() + h.y()) : Vector2d(a.x() + h.x(), a.y());
         const bool onBoundary = d == 0 ? (i == 0 || i == s[0] - 1) : (j == 0 || j == s[1] - 1);
         const double len = onBoundary ? boundaryOpenLength(apparatus, a, b) : openSegmentLength(apparatus, a, b);
-        section[std::size_t(j) * s[0] + i] = snap(len / (b - a).norm());
+        double f = snap(len / (b - a).norm());
+        // A baffle closes its share of the face (the same in every z-layer: the plates span the depth).
+        if (!out.baffles.covered[std::size_t(d)].empty())
+          f = snap(std::max(0.0, f - out.baffles.covered[std::size_t(d)][out.baffles.index(d, i, j, 0)]));
+        section[std::size_t(j) * s[0] + i] = f;
       }
     }
     for (int k = 0; k < s[2]; ++k)

@@ -11,16 +11,20 @@
 
 #include "geometry/Apparatus.hpp"
 #include "geometry/CartesianGrid.hpp"
+#include "geometry/ThinWalls.hpp"
 
 namespace rcfd::gas {
 
 /// Open fraction [0, 1] of every face normal to each axis. Face arrays of axis d have the shape of the
 /// cells plus one along d, stored x fastest: index = (k * nyF + j) * nxF + i. Faces on the grid's outer
 /// boundary are open where the apparatus boundary there is an inlet or an outlet (the slot at y = 0,
-/// the top), zero elsewhere (walls, including the front and back walls at z = 0 and z = depth).
+/// the top), zero elsewhere (walls, including the front and back walls at z = 0 and z = depth). Plates
+/// thinner than a cell close their nearest face as baffles (ThinWalls.hpp): their covered fraction is
+/// taken off that face's aperture.
 struct FaceApertures {
   std::array<std::array<int, 3>, 3> shape{};  ///< per axis d: face counts (nx + [d==0], ...)
   std::array<std::vector<double>, 3> open;    ///< per axis d: aperture of each face [-]
+  BaffleFaces baffles;                        ///< the thin-wall baffles included in `open`
 };
 
 FaceApertures computeFaceApertures(const Apparatus& apparatus, const CartesianGrid& grid);

@@ -320,6 +320,37 @@ double GasSolver::ghostValue(const std::vector<double>& u, int d, int e, std::ar
   return sign * u[faceIndex(d, idx[0], idx[1], idx[2])];
 }
 
+bool GasSolver::baffleAhead(int d, int e, std::array<int, 3> idx) const {
+  // Face idx of axis d lies between cells idx - e_d and idx; a step along +e leaves both cells through
+  // their e-faces at index + 1: a baffle when it closes both (a plate tip closing one is no wall).
+  if (idx[std::size_t(e)] < 0 || idx[std::size_t(e)] >= grid_.shape[std::size_t(e)]) return false;
+  idx[std::size_t(e)] += 1;
+  std::array<int, 3> lo = idx;
+  lo[std::size_t(d)] -= 1;
+  return ap_.baffles.closes(e, idx[0], idx[1], idx[2]) && ap_.baffles.closes(e, lo[0], lo[1], lo[2]);
+}
+
+void GasSolver::mirrorAtBaffles(int d, int e, const std::array<int, 3>& idx, double v[5]) const {
+  // A baffle lies midway between two neighbouring face values of axis d along e != d: the values behind
+  // it are replaced by the odd mirror image of those in front (no-slip, as at the outer walls), so no
+  // momentum is advected or diffused through a plate.
+  auto shifted = [&](int m) {
+    std::array<int, 3> q = idx;
+    q[std::size_t(e)] += m;
+    return q;
+  };
+  if (baffleAhead(d, e, idx)) {
+    v[3] = -v[2], v[4] = -v[1];
+  } else if (baffleAhead(d, e, shifted(1))) {
+    v[4] = -v[3];
+  }
+  if (baffleAhead(d, e, shifted(-1))) {
+    v[1] = -v[2], v[0] = -v[3];
+  } else if (baffleAhead(d, e, shifted(-2))) {
+    v[0] = -v[1];
+  }
+}
+
 void GasSolver::explicitRates(const std::array<std::vector<double>, 3>& u,
                               std::array<std::vector<double>, 3>& rate) const {
   const Eigen::Vector3d h = grid_.spacing;
@@ -371,6 +402,7 @@ void GasSolver::explicitRates(const std::array<std::vector<double>, 3>& u,
                                : ghostValue(ud, d, e, q);
               }
             }
+            if (e != d && !ap_.baffles.empty()) mirrorAtBaffles(d, e, idx, v);
             // Second-order upwind with a van Leer limiter (first order at extrema): the advective
             // derivative a dphi/dx from limited upwind values at the two half-points.
             double plus, minus;

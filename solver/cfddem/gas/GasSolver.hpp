@@ -144,6 +144,10 @@ class GasSolver {
   double convectiveRate() const;
   void explicitRates(const std::array<std::vector<double>, 3>& u, std::array<std::vector<double>, 3>& rate) const;
   double ghostValue(const std::vector<double>& u, int d, int e, std::array<int, 3> idx) const;
+  /// Whether a baffle (thin plate) closes the way from face idx of axis d to its neighbour at +e.
+  bool baffleAhead(int d, int e, std::array<int, 3> idx) const;
+  /// Stencil values v[0..4] (offsets -2..2 along e of face idx, axis d): no-slip mirror at baffles.
+  void mirrorAtBaffles(int d, int e, const std::array<int, 3>& idx, double v[5]) const;
   double faceAlpha(int d, std::size_t f, int i, int j, int k) const;
   void project(double dt, const std::array<std::vector<double>, 3>& diag);
   void correct(const std::array<std::vector<double>, 3>& diag);

@@ -1,0 +1,43 @@
+#pragma once
+/// \file ThinWalls.hpp
+/// Walls thinner than a cell as zero-thickness baffles on grid faces. A draft plate whose extent along
+/// x (or y) lies inside one cell column, with no grid face strictly inside it, removes volume from its
+/// cells (openFractions) but meets no face, so per-cell open fractions alone let gas, mapped particle
+/// volume and smoothing pass straight through it. As CFD codes do with baffles (OpenFOAM's
+/// createBaffles turns internal faces into wall faces on both sides), such a plate is snapped to the
+/// grid face nearest to its mid-plane (an exact tie goes to the lower face) and covers that face over its extent
+/// along the other axis. Plates that contain a face already close it (FaceApertures), so they give no
+/// baffle here. The plates span the whole depth: baffles are x- and y-faces only.
+
+#include <array>
+#include <vector>
+
+#include "geometry/Apparatus.hpp"
+#include "geometry/CartesianGrid.hpp"
+
+namespace rcfd {
+
+/// Per grid face, the fraction of its area covered by a baffle [0, 1]. Face arrays of axis d have the
+/// shape of the cells plus one along d, x fastest (the layout of gas::FaceApertures). Empty arrays when
+/// the apparatus has no wall thinner than a cell (the common case costs nothing).
+struct BaffleFaces {
+  std::array<std::array<int, 3>, 3> shape{};  ///< per axis d: face counts (nx + [d==0], ...)
+  std::array<std::vector<double>, 3> covered;  ///< per axis d: covered fraction of each face [-]
+
+  bool empty() const { return covered[0].empty() && covered[1].empty(); }
+  std::size_t index(int d, int i, int j, int k) const {
+    const auto& s = shape[std::size_t(d)];
+    return (std::size_t(k) * s[1] + j) * s[0] + i;
+  }
+  /// True when the face of axis d at face index (i, j, k) is wholly covered: nothing crosses it.
+  bool closes(int d, int i, int j, int k) const {
+    const auto& c = covered[std::size_t(d)];
+    return !c.empty() && c[index(d, i, j, k)] >= 1.0;
+  }
+};
+
+/// The baffles of the apparatus's thin plates on grid (exact covered fractions: the plates and the
+/// faces are axis-aligned).
+BaffleFaces thinWallBaffles(const Apparatus& apparatus, const CartesianGrid& grid);
+
+}  // namespace rcfd

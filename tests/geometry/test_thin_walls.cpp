@@ -1,0 +1,84 @@
+// thinWallBaffles(): a plate thinner than a cell, inside one cell column, closes the face nearest to
+// its mid-plane over its extent; plates resolved by the grid and apparatus without plates give none.
+
+#include <gtest/gtest.h>
+
+#include "GeometryFixtures.hpp"
+#include "geometry/ThinWalls.hpp"
+
+namespace rcfd {
+namespace {
+
+/// The quick slice: ProCell section 0.02 m deep, 5 mm cells (50 x 120 x 4), x from -0.125 m.
+CartesianGrid sliceGrid(const Apparatus& app, double cell) {
+  GridSpec spec;
+  spec.cell_size = Vec3(cell, cell, cell);
+  return makeGrid(app, spec);
+}
+
+ApparatusSpec slice(bool plates) {
+  ApparatusSpec a = test::procellSpec(plates);
+  a.depth = 0.02;
+  return a;
+}
+
+TEST(ThinWalls, PlateInsideACellColumnClosesItsNearestFace) {
+  const Apparatus app(slice(true));
+  const CartesianGrid g = sliceGrid(app, 0.005);
+  ASSERT_EQ(g.shape, (std::array<int, 3>{50, 120, 4}));
+  const BaffleFaces b = thinWallBaffles(app, g);
+  ASSERT_FALSE(b.empty());
+  // Right plate x in [0.0225, 0.0245] lies in the column [0.020, 0.025]: its mid-plane 0.0235 is
+  // 1.5 mm from the face x = 0.025 (index 30) and 3.5 mm from x = 0.020 (index 29). The left plate
+  // mirrors it onto x = -0.025 (index 20). y from 0.035 to 0.095: rows 7..18, whole faces.
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 120; ++j) {
+      const bool along = j >= 7 && j <= 18;
+      for (int i = 0; i <= 50; ++i) {
+        const bool baffle = along && (i == 30 || i == 20);
+        ASSERT_EQ(b.covered[0][b.index(0, i, j, k)], baffle ? 1.0 : 0.0) << i << " " << j << " " << k;
+        ASSERT_EQ(b.closes(0, i, j, k), baffle);
+      }
+    }
+  // The plates are 12 cells tall: the grid's y-faces inside them are cut by FaceApertures already.
+  EXPECT_TRUE(b.covered[1].empty());
+  EXPECT_FALSE(b.closes(1, 30, 10, 0));
+}
+
+TEST(ThinWalls, PartlyCoveredFaceAtAPlateTipIsNotClosed) {
+  ApparatusSpec spec = slice(true);
+  spec.draft_plates->elevation = 0.037;  // lower edge 3 mm into the row [0.035, 0.040]
+  spec.draft_plates->height = 0.0605;    // upper edge at 0.0975, half-way up the row [0.095, 0.100]
+  const Apparatus app(spec);
+  const CartesianGrid g = sliceGrid(app, 0.005);
+  const BaffleFaces b = thinWallBaffles(app, g);
+  EXPECT_NEAR(b.covered[0][b.index(0, 30, 7, 2)], 0.6, 1e-12);
+  EXPECT_FALSE(b.closes(0, 30, 7, 2));
+  EXPECT_EQ(b.covered[0][b.index(0, 30, 8, 2)], 1.0);
+  EXPECT_NEAR(b.covered[0][b.index(0, 30, 19, 2)], 0.5, 1e-12);
+  EXPECT_EQ(b.covered[0][b.index(0, 30, 20, 2)], 0.0);
+  EXPECT_EQ(b.covered[0][b.index(0, 30, 6, 2)], 0.0);
+}
+
+TEST(ThinWalls, PlateInTheLowerHalfOfItsColumnClosesTheLowerFace) {
+  ApparatusSpec spec = slice(true);
+  spec.draft_plates->gap = 0.042;  // right plate x in [0.021, 0.023]: mid-plane 2 mm above x = 0.020
+  const Apparatus app(spec);
+  const BaffleFaces b = thinWallBaffles(app, sliceGrid(app, 0.005));
+  EXPECT_TRUE(b.closes(0, 29, 10, 0));   // x = 0.020
+  EXPECT_FALSE(b.closes(0, 30, 10, 0));  // x = 0.025
+  EXPECT_TRUE(b.closes(0, 21, 10, 0));   // the left plate mirrors it onto x = -0.020
+}
+
+TEST(ThinWalls, ResolvedPlatesAndApparatusWithoutPlatesHaveNoBaffles) {
+  // 0.5 mm cells: faces lie inside the plates (they are closed by the cut cells and face apertures).
+  const Apparatus plates(slice(true));
+  EXPECT_TRUE(thinWallBaffles(plates, sliceGrid(plates, 0.0005)).empty());
+  const Apparatus none(slice(false));
+  EXPECT_TRUE(thinWallBaffles(none, sliceGrid(none, 0.005)).empty());
+  const Apparatus box(test::boxSpec(0.1, 0.2, 0.02, true));
+  EXPECT_TRUE(thinWallBaffles(box, sliceGrid(box, 0.005)).empty());
+}
+
+}  // namespace
+}  // namespace rcfd
