@@ -56,7 +56,6 @@ struct Context {
   double gravity[3] = {};           ///< [m/s2]
   double restitution = 1.0;         ///< normal restitution of free-flying tracers at walls [-]
   bool midpoint = true;
-  bool walls = true;
 };
 
 /// Sub-steps of the lanes of a block so that none moves farther than max_courant cells at its start

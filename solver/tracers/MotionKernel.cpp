@@ -200,7 +200,6 @@ void MotionKernel::move(TracerContext& ctx) {
   bc.sy = grid_.shape[0], bc.sz = grid_.shape[0] * grid_.shape[1];
   bc.noWall = walls ? 0.0 : 1e300;
   bc.midpoint = midpoint;
-  bc.walls = walls;
   if (walls && halfSpaces_.size() <= std::size_t(Context::kMaxHalfSpaces)) {
     bc.halfSpaces = int(halfSpaces_.size());
     for (int j = 0; j < bc.halfSpaces; ++j) {
@@ -314,18 +313,28 @@ void MotionKernel::move(TracerContext& ctx) {
       // hold u as it is computed), unless some are in free flight.
       alignas(64) double h[kBlock];
       alignas(64) std::int32_t left[kBlock];
-      LaneStorage compact;
-      Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, pvx + i0, pvy + i0, pvz + i0, h, left, count};
-      if (freeLanes > 0) {
+      // Lanes in free flight (or not) copied out of the cloud, and back (blocks with both kinds only).
+      auto takeLanes = [&](bool freeFlying, LaneStorage& ls) {
         int j = 0;
         for (int k = 0; k < count; ++k) {
-          if (free[k]) continue;
-          compact.x[j] = px[i0 + k], compact.y[j] = py[i0 + k], compact.z[j] = pz[i0 + k];
-          compact.ax[j] = ax[k], compact.ay[j] = ay[k], compact.az[j] = az[k];
-          compact.lane[j++] = k;
+          if ((free[k] != 0) != freeFlying) continue;
+          ls.x[j] = px[i0 + k], ls.y[j] = py[i0 + k], ls.z[j] = pz[i0 + k];
+          ls.ux[j] = pvx[i0 + k], ls.uy[j] = pvy[i0 + k], ls.uz[j] = pvz[i0 + k];  // free flight's own velocity
+          ls.ax[j] = freeFlying ? 0.0 : ax[k], ls.ay[j] = freeFlying ? 0.0 : ay[k], ls.az[j] = freeFlying ? 0.0 : az[k];
+          ls.lane[j++] = k;
         }
-        L = compact.view(j);
-      }
+        return ls.view(j);
+      };
+      auto putBack = [&](const Lanes& lanes, const LaneStorage& ls) {
+        for (int j = 0; j < lanes.count; ++j) {
+          const std::int64_t i = i0 + ls.lane[j];
+          px[i] = lanes.x[j], py[i] = lanes.y[j], pz[i] = lanes.z[j];
+          pvx[i] = lanes.ux[j], pvy[i] = lanes.uy[j], pvz[i] = lanes.uz[j];
+        }
+      };
+      LaneStorage compact;
+      Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, pvx + i0, pvy + i0, pvz + i0, h, left, count};
+      if (freeLanes > 0) L = takeLanes(false, compact);
       const int m = L.count;
       // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
       BlockStencils stencils;
@@ -338,29 +347,13 @@ void MotionKernel::move(TracerContext& ctx) {
       };
       advanceLanes(L, countSubsteps(L), stencils, false, bc, st);
       if (freeLanes > 0) {
-        for (int j = 0; j < m; ++j) {
-          const std::int64_t i = i0 + compact.lane[j];
-          px[i] = L.x[j], py[i] = L.y[j], pz[i] = L.z[j];
-          pvx[i] = L.ux[j], pvy[i] = L.uy[j], pvz[i] = L.uz[j];
-        }
+        putBack(L, compact);
         // Free flight: the tracers' own velocities, sub-stepped by them.
         LaneStorage fs;
-        int f = 0;
-        for (int k = 0; k < count; ++k) {
-          if (!free[k]) continue;
-          fs.x[f] = px[i0 + k], fs.y[f] = py[i0 + k], fs.z[f] = pz[i0 + k];
-          fs.ux[f] = pvx[i0 + k], fs.uy[f] = pvy[i0 + k], fs.uz[f] = pvz[i0 + k];
-          fs.ax[f] = fs.ay[f] = fs.az[f] = 0.0;
-          fs.lane[f++] = k;
-        }
-        Lanes F = fs.view(f);
-        st.freeFlight += f;
+        Lanes F = takeLanes(true, fs);
+        st.freeFlight += F.count;
         advanceLanes(F, countSubsteps(F), stencils, true, bc, st);
-        for (int j = 0; j < f; ++j) {
-          const std::int64_t i = i0 + fs.lane[j];
-          px[i] = F.x[j], py[i] = F.y[j], pz[i] = F.z[j];
-          pvx[i] = F.ux[j], pvy[i] = F.uy[j], pvz[i] = F.uz[j];
-        }
+        putBack(F, fs);
       }
     }
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
