@@ -82,7 +82,7 @@ class MotionKernel {
   /// line: [2c] reach_ [m] (0 without walls), [2c+1] |u_fluc| of Eq. (10) capped at
   /// u_fluc_max [m/s] (0 without fluctuation).
   std::vector<float> cellData_;
-  bool hadSpeeds_ = true;  ///< cellData_ may hold speeds of an earlier step (cleared when fluctuation stops)
+  bool hadSpeeds_ = false;  ///< cellData_ holds speeds of an earlier step (zeroed when fluctuation stops)
 };
 
 }  // namespace rcfd
