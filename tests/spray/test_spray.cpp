@@ -16,7 +16,7 @@ using namespace rcfd::test;
 
 namespace {
 nlohmann::json results(const TracerSimulation& sim, const std::string& name) {
-  h5::File out(testing::TempDir() + name + ".h5", h5::File::Mode::Create);
+  h5::File out(tempPath(name + ".h5"), h5::File::Mode::Create);
   nlohmann::json summary;
   sim.writeResults(out, summary);
   return summary;
@@ -183,7 +183,7 @@ TEST(Spray, OneAndTwoThreadsAndResumeAreBitIdentical) {
     TracerSimulation sim(s, db, path, {21, steps, 0});
     std::unique_ptr<TracerSimulation> resumed;
     TracerSimulation* active = &sim;
-    const std::string checkpoint = testing::TempDir() + "spray-checkpoint.h5";
+    const std::string checkpoint = tempPath("spray-checkpoint.h5");
     for (std::int64_t k = 0; k < steps; ++k) {
       if (k == checkpointAt) {
         sim.saveCheckpoint(checkpoint);

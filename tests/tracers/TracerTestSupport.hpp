@@ -4,6 +4,7 @@
 #include <functional>
 #include <numbers>
 
+#include "../fields/FieldTestUtil.hpp"
 #include "fields/AnalyticDatabase.hpp"
 #include "geometry/Apparatus.hpp"
 #include "recurrence/RecurrencePath.hpp"

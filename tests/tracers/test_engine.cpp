@@ -52,7 +52,7 @@ RunResult runFor(const Scene& s, std::shared_ptr<FieldDatabase> db, std::int64_t
                  std::int64_t checkpointAt = -1) {
   omp_set_num_threads(threads);
   RecurrencePath path = sequentialPath(db->frameCount(), steps + 2);
-  const std::string checkpoint = testing::TempDir() + "engine-checkpoint.h5";
+  const std::string checkpoint = tempPath("engine-checkpoint.h5");
   TracerSimulation sim(s, db, path, {42, steps, 10});
   std::unique_ptr<TracerSimulation> resumed;
   TracerSimulation* active = &sim;
@@ -66,7 +66,7 @@ RunResult runFor(const Scene& s, std::shared_ptr<FieldDatabase> db, std::int64_t
     active->step();
   }
   RunResult r{active->cloud(), {}};
-  h5::File out(testing::TempDir() + "engine-result.h5", h5::File::Mode::Create);
+  h5::File out(tempPath("engine-result.h5"), h5::File::Mode::Create);
   active->writeResults(out, r.summary);
   omp_set_num_threads(2);
   return r;

@@ -123,7 +123,7 @@ TEST(ResidenceTime, PlugFlowGivesZoneHeightOverSpeed) {
   const std::int64_t steps = 75;  // tracers reach at most y = 0.95: nobody comes back down
   TracerSimulation sim(s, db, path, {5, steps, 0});
   for (std::int64_t k = 0; k < steps; ++k) sim.step();
-  h5::File out(testing::TempDir() + "plug.h5", h5::File::Mode::Create);
+  h5::File out(tempPath("plug.h5"), h5::File::Mode::Create);
   nlohmann::json summary;
   sim.writeResults(out, summary);
   const auto counts = out.readInt64s("/residence_time/duration_steps_counts");
