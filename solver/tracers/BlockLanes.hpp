@@ -40,7 +40,7 @@ struct Context {
   const float* cellData = nullptr;  ///< MotionKernel::cellData_
   const float* plateReach = nullptr;  ///< per cell, or null without draft plates
   TrilinearLocator::Constants q{};
-  std::int32_t corner4[8] = {};     ///< corner offsets in floats of the step field
+  CornerOffsets corners;            ///< corner offsets in floats of the step fields
   double origin[3] = {}, inv[3] = {}, spacing[3] = {};
   int last[3] = {};
   std::int32_t sy = 0, sz = 0;

@@ -129,26 +129,24 @@ void MotionKernel::prepare(const TracerContext& ctx, const FrameSampler& sampler
 }
 
 namespace {
-/// The 8 corners of the last stencil gathered from a step field: a sub-step's midpoint mostly lies in
-/// the same block of cell centres as its start, and then needs no second gather.
-class CornerCache {
+/// u at a point of a step field: the block path's arithmetic (block::interpolateCorners) for one point.
+class PointSampler {
  public:
-  CornerCache(const StepVelocityField& field, const TrilinearLocator& locator) : field_(field), locator_(locator) {}
-  Eigen::Vector3d sample(const TrilinearStencil& s) {
-    if (s.base != base_) {
-      field_.gather(s.base, locator_, corners_);
-      base_ = s.base;
-    }
-    const Eigen::Array4d u = trilinear(corners_, s.f);
-    return {u[0], u[1], u[2]};
+  PointSampler(const StepVelocityField& field, const TrilinearLocator& locator) : field_(field), locator_(locator) {
+    corners_.set(locator.offsets32());
   }
-  Eigen::Vector3d sample(const Eigen::Vector3d& p) { return sample(locator_.locate(p)); }
+  Eigen::Vector3d sample(const Eigen::Vector3d& p) const {
+    const TrilinearStencil s = locator_.locate(p);
+    float u[3];
+    block::interpolateCorners(field_.floats() + 4 * s.base, corners_.off4, float(s.f[0]), float(s.f[1]),
+                              float(s.f[2]), u);
+    return {double(u[0]), double(u[1]), double(u[2])};
+  }
 
  private:
   const StepVelocityField& field_;
   const TrilinearLocator& locator_;
-  std::int64_t base_ = -1;
-  Eigen::Array4d corners_[8];
+  block::CornerOffsets corners_;
 };
 }  // namespace
 
@@ -192,7 +190,7 @@ void MotionKernel::move(TracerContext& ctx) {
   bc.cellData = cellData_.data();
   bc.plateReach = plateReach_.empty() ? nullptr : plateReach_.data();
   bc.q = locator.constants();
-  for (int c = 0; c < 8; ++c) bc.corner4[c] = 4 * locator.offsets32()[c];
+  bc.corners.set(locator.offsets32());
   for (int d = 0; d < 3; ++d) {
     bc.origin[d] = grid_.origin[d], bc.inv[d] = 1.0 / grid_.spacing[d], bc.spacing[d] = grid_.spacing[d];
     bc.last[d] = grid_.shape[d] - 1;
@@ -219,7 +217,7 @@ void MotionKernel::move(TracerContext& ctx) {
     if (settings_.freeFlight && sampler.alphaP(cell) < settings_.freeFlightAlpha) {
       // Free flight: implicit drag relaxation toward u_G^rec plus gravity, stable for any dt / tau.
       ++st.freeFlight;
-      CornerCache gas(gasVelocity_, locator);
+      const PointSampler gas(gasVelocity_, locator);
       const int nsub = substepsFor(v.norm() * dt, st.substepCapped);
       const double h = dt / nsub;
       for (int s = 0; s < nsub; ++s) {
@@ -233,7 +231,7 @@ void MotionKernel::move(TracerContext& ctx) {
       }
       st.substeps += nsub - 1;
     } else {
-      CornerCache up(particleVelocity_, locator);
+      const PointSampler up(particleVelocity_, locator);
       Eigen::Vector3d u = up.sample(p) + fluc;  // Eq. (9)
       const int nsub = substepsFor(u.norm() * dt, st.substepCapped);
       const double h = dt / nsub;
@@ -338,9 +336,8 @@ void MotionKernel::move(TracerContext& ctx) {
       const int m = L.count;
       // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
       BlockStencils stencils;
-      locateBlock(bc.q, m, L.x, L.y, L.z, stencils, nullptr);
-      gatherBlock(bc.field, bc.corner4, m, stencils);
-      interpolateBlock(stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+      locateBlock(bc.q, m, L.x, L.y, L.z, stencils);
+      sampleBlock(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
       auto countSubsteps = [&](Lanes& lanes) {
         return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
                                double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);

@@ -15,22 +15,18 @@ void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sample
                            MotionStatistics& st) const {
   const int m = L.count;
   if (!sampled) {  // Eq. (9): u_P^rec at the sub-step's start
-    locateBlock(bc.q, m, L.x, L.y, L.z, s, nullptr);
-    gatherBlock(bc.field, bc.corner4, m, s);
-    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+    locateBlock(bc.q, m, L.x, L.y, L.z, s);
+    sampleBlock(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
   }
-  if (bc.midpoint) {
-    // Midpoint rule (see moveOne); its stencil reuses the start's corners where it is the same.
+  if (bc.midpoint) {  // the midpoint rule (see moveOne)
     alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];
-    alignas(64) std::int32_t midBase[kBlock];
 #pragma omp simd
     for (int k = 0; k < m; ++k) {
       const double half = 0.5 * L.h[k];
       mx[k] = L.x[k] + half * L.ux[k], my[k] = L.y[k] + half * L.uy[k], mz[k] = L.z[k] + half * L.uz[k];
     }
-    locateBlock(bc.q, m, mx, my, mz, s, midBase);
-    regatherChanged(bc.field, bc.corner4, m, midBase, s);
-    interpolateBlock(s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+    locateBlock(bc.q, m, mx, my, mz, s);
+    sampleBlock(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
   }
   moveLanes(L, bc, st, false);
 }
@@ -124,9 +120,8 @@ void MotionKernel::freeFlightSubStep(block::Lanes& F, block::BlockStencils& s, c
   // u_G^rec at the sub-step's start (no fluctuation in free flight).
   alignas(64) static constexpr double kZero[kBlock] = {};
   alignas(64) double gx[kBlock], gy[kBlock], gz[kBlock];
-  locateBlock(bc.q, m, F.x, F.y, F.z, s, nullptr);
-  gatherBlock(bc.gasField, bc.corner4, m, s);
-  interpolateBlock(s, m, kZero, kZero, kZero, gx, gy, gz);
+  locateBlock(bc.q, m, F.x, F.y, F.z, s);
+  sampleBlock(bc.gasField, bc.corners, s, m, kZero, kZero, kZero, gx, gy, gz);
   // Implicit drag relaxation toward u_G^rec plus gravity, stable for any h / tau (as moveOne).
   double* const vx = F.ux;
   double* const vy = F.uy;

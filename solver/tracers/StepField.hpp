@@ -2,7 +2,7 @@
 /// \file StepField.hpp
 /// A recurrence velocity field prepared for one tracer step: 4 floats per cell (x, y, z, 0), 16-byte
 /// aligned, blended between the step's two frames once per cell rather than once per tracer and
-/// corner. The motion kernel then fetches a corner with one aligned load. Rebuilding costs one pass
+/// corner. The motion kernel then fetches a corner and its x-neighbour with one 32-byte load. Rebuilding costs one pass
 /// over the cells (74k) per step against 8-16 corner loads for each of the 473k tracers.
 /// Blended values are rounded to float, the precision the database stores frames in.
 
@@ -37,11 +37,6 @@ class StepVelocityField {
       }
       out[3] = 0.0f;
     }
-  }
-
-  /// The 8 corners of a stencil with low corner `base`, in double (lane 3 is 0).
-  void gather(std::int64_t base, const TrilinearLocator& locator, Eigen::Array4d* corners) const {
-    for (int c = 0; c < 8; ++c) corners[c] = data_[std::size_t(base + locator.offset(c))].cast<double>();
   }
 
   /// The field as 4 floats per cell (x, y, z, 0).

@@ -2,8 +2,8 @@
 /// \file Trilinear.hpp
 /// Trilinear interpolation between cell centres, split for the tracer hot loop into locating a point
 /// (one base index and three fractions) and combining the 8 corner values of that base. The 8 corners
-/// are the base plus fixed offsets, so a stencil needs one index computation, and two points with the
-/// same base (a sub-step's start and its midpoint, mostly) share one gather of the corners.
+/// are the base plus fixed offsets, so a stencil needs one index computation (the motion kernel's
+/// float combination of the corners is block::interpolateCorners).
 /// Beyond the outermost centres values are extrapolated as constants (the fractions are clamped).
 
 #include <algorithm>
