@@ -20,6 +20,8 @@ struct Lanes {
   double* h;                 ///< sub-step [s]
   std::int32_t* left;        ///< sub-steps still to take after this round
   int count = 0;
+  /// The cells of the positions (the step's first round: the tracers' cells), or null (later rounds)
+  const std::int32_t* cell = nullptr;
 };
 
 /// Storage of compacted lanes.
@@ -29,8 +31,11 @@ struct LaneStorage {
   alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];
   alignas(64) double h[kBlock];
   alignas(64) std::int32_t left[kBlock];
+  alignas(64) std::int32_t cell[kBlock];
   std::int32_t lane[kBlock];  ///< the lane's index in the lanes it was compacted from
-  Lanes view(int count) { return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count}; }
+  Lanes view(int count, bool withCells = false) {
+    return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count, withCells ? cell : nullptr};
+  }
 };
 
 /// What every sub-step round of a move() reads: the step field, the grid and the walls as plain values.
@@ -49,6 +54,7 @@ struct Context {
   double hx[kMaxHalfSpaces] = {}, hy[kMaxHalfSpaces] = {}, hz[kMaxHalfSpaces] = {}, hc[kMaxHalfSpaces] = {};
   double margin = 0.0;              ///< 2 boundaryTolerance() [m]
   double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
+  double halfDiagonal = 0.0;        ///< half a cell diagonal: no point of a cell is farther from its centre [m]
   static constexpr int kMaxSubsteps = 64;  ///< MotionKernel::kMaxSubsteps
   double substepLength[kMaxSubsteps + 1] = {};  ///< [n] = dt / n [s]
   double inverseStokesTime = 0.0;   ///< 18 rho_G nu_G / (rho_P d_P^2) [1/s]

@@ -197,6 +197,7 @@ void MotionKernel::move(TracerContext& ctx) {
   }
   bc.sy = grid_.shape[0], bc.sz = grid_.shape[0] * grid_.shape[1];
   bc.noWall = walls ? 0.0 : 1e300;
+  bc.halfDiagonal = 0.5 * grid_.spacing.norm();
   bc.midpoint = midpoint;
   if (walls && halfSpaces_.size() <= std::size_t(Context::kMaxHalfSpaces)) {
     bc.halfSpaces = int(halfSpaces_.size());
@@ -319,9 +320,10 @@ void MotionKernel::move(TracerContext& ctx) {
           ls.x[j] = px[i0 + k], ls.y[j] = py[i0 + k], ls.z[j] = pz[i0 + k];
           ls.ux[j] = pvx[i0 + k], ls.uy[j] = pvy[i0 + k], ls.uz[j] = pvz[i0 + k];  // free flight's own velocity
           ls.ax[j] = freeFlying ? 0.0 : ax[k], ls.ay[j] = freeFlying ? 0.0 : ay[k], ls.az[j] = freeFlying ? 0.0 : az[k];
+          ls.cell[j] = cellOf[k];
           ls.lane[j++] = k;
         }
-        return ls.view(j);
+        return ls.view(j, true);
       };
       auto putBack = [&](const Lanes& lanes, const LaneStorage& ls) {
         for (int j = 0; j < lanes.count; ++j) {
@@ -331,7 +333,7 @@ void MotionKernel::move(TracerContext& ctx) {
         }
       };
       LaneStorage compact;
-      Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, pvx + i0, pvy + i0, pvz + i0, h, left, count};
+      Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, pvx + i0, pvy + i0, pvz + i0, h, left, count, cellOf};
       if (freeLanes > 0) L = takeLanes(false, compact);
       const int m = L.count;
       // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
