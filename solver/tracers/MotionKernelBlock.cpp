@@ -176,13 +176,16 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
   for (std::int32_t round = 1; round <= maxLeft; ++round) {
     LaneStorage rs;
     int r = 0;
-    for (int k = 0; k < m; ++k) {
-      if (L.left[k] <= 0) continue;
-      rs.x[r] = L.x[k], rs.y[r] = L.y[k], rs.z[r] = L.z[k];
-      rs.ax[r] = L.ax[k], rs.ay[r] = L.ay[k], rs.az[r] = L.az[k];
-      rs.ux[r] = L.ux[k], rs.uy[r] = L.uy[k], rs.uz[r] = L.uz[k];
-      rs.h[r] = L.h[k];
-      rs.lane[r++] = k;
+    for (int k = 0; k < m; ++k) {  // without branches: few lanes have sub-steps left, at random
+      rs.lane[r] = k;
+      r += L.left[k] > 0;
+    }
+    for (int j = 0; j < r; ++j) {
+      const int k = rs.lane[j];
+      rs.x[j] = L.x[k], rs.y[j] = L.y[k], rs.z[j] = L.z[k];
+      rs.ax[j] = L.ax[k], rs.ay[j] = L.ay[k], rs.az[j] = L.az[k];
+      rs.ux[j] = L.ux[k], rs.uy[j] = L.uy[k], rs.uz[j] = L.uz[k];
+      rs.h[j] = L.h[k];
       --L.left[k];
     }
     Lanes R = rs.view(r);
