@@ -39,13 +39,16 @@ class TracerVolumeFractionEffect final : public TracerEffect {
       used = omp_get_num_threads();
       std::int32_t* histogram = t == 0 ? count.data() : partial_.data() + std::size_t(t - 1) * std::size_t(cells);
       std::fill(histogram, histogram + cells, 0);
-      // The cell of every tracer: CartesianGrid::cellOf's arithmetic on plain locals, which vectorises.
+      // The cell of every tracer, on plain locals, which vectorises.
       const double* x = cloud.x.data();
       const double* y = cloud.y.data();
       const double* z = cloud.z.data();
       std::int32_t* cellOut = ctx.tracerCell.data();
       const double ox = ctx.grid.origin.x(), oy = ctx.grid.origin.y(), oz = ctx.grid.origin.z();
-      const double hx = ctx.grid.spacing.x(), hy = ctx.grid.spacing.y(), hz = ctx.grid.spacing.z();
+      // Multiplications by the inverse spacing, not CartesianGrid's divisions (a vector division costs
+      // as much as the rest of the loop): a point within an ulp of a cell face may land in the
+      // neighbour, which no user of the cells can tell (the motion kernel's wall bound allows for it).
+      const double ihx = 1.0 / ctx.grid.spacing.x(), ihy = 1.0 / ctx.grid.spacing.y(), ihz = 1.0 / ctx.grid.spacing.z();
       const int nx = ctx.grid.shape[0], ny = ctx.grid.shape[1], nz = ctx.grid.shape[2];
       constexpr std::int64_t kBlock = 256;  // blocks of plain int loops: what GCC's vectoriser takes
 #pragma omp for schedule(static)
@@ -60,7 +63,7 @@ class TracerVolumeFractionEffect final : public TracerEffect {
         for (int k = 0; k < count; ++k) {
           // int(floor(t)) as truncation corrected for negative t (the same integer; floor itself does
           // not vectorise under GCC's default trapping-math).
-          const double tx = (bx[k] - ox) / hx, ty = (by[k] - oy) / hy, tz = (bz[k] - oz) / hz;
+          const double tx = (bx[k] - ox) * ihx, ty = (by[k] - oy) * ihy, tz = (bz[k] - oz) * ihz;
           int ci = int(tx), cj = int(ty), ck = int(tz);
           ci -= double(ci) > tx, cj -= double(cj) > ty, ck -= double(ck) > tz;
           ci = ci < 0 ? 0 : (ci >= nx ? nx - 1 : ci);
