@@ -75,20 +75,24 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   std::int64_t pending = 0;
   const std::int32_t* startCell = L.cell;
   const double halfDiagonal = bc.halfDiagonal;
-#pragma omp simd reduction(+ : pending)
+#pragma omp simd
   for (int k = 0; k < m; ++k) {
     const double dx = h[k] * ux[k], dy = h[k] * uy[k], dz = h[k] * uz[k];
     ex[k] = x[k] + dx, ey[k] = y[k] + dy, ez[k] = z[k] + dz;
     length[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
-    fast[k] = 0;
-    if (startCell) {
-      // The lanes' cells are known (the step's first round): the bound with |p - c| <= half a
-      // diagonal spares locating every start point.
+  }
+  if (startCell) {
+    // The lanes' cells are known (the step's first round): the bound with |p - c| <= half a diagonal
+    // spares locating every start point. (A separate loop: a branch inside stops the vectoriser.)
+#pragma omp simd reduction(+ : pending)
+    for (int k = 0; k < m; ++k) {
       off[k] = halfDiagonal;
       cell[k] = startCell[k];
       fast[k] = off[k] + length[k] < double(cellData[2 * cell[k]]) + noWall;
+      pending += 1 - fast[k];
     }
-    pending += 1 - fast[k];
+  } else {
+    for (int k = 0; k < m; ++k) fast[k] = 0;
   }
   // The sharper per-point bound where the cells are not known, and near draft plates, whose test below
   // takes the distance from the centre.
