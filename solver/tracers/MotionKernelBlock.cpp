@@ -49,29 +49,6 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   alignas(64) std::int32_t cell[kBlock];
   const float* cellData = bc.cellData;
   const double noWall = bc.noWall;
-  // The per-point bound: the start's cell and its distance from the cell's centre.
-  auto pointBound = [&] {
-    std::int64_t notCleared = 0;
-#pragma omp simd reduction(+ : notCleared)
-    for (int k = 0; k < m; ++k) {
-      int ci[3];
-      double off2 = 0.0;
-      const double pk[3] = {x[k], y[k], z[k]};
-      for (int d = 0; d < 3; ++d) {
-        const double t = (pk[d] - bc.origin[d]) * bc.inv[d];
-        const int i = int(t > 0.0 ? t : 0.0);
-        ci[d] = i < bc.last[d] ? i : bc.last[d];
-        const double e = pk[d] - (bc.origin[d] + (double(ci[d]) + 0.5) * bc.spacing[d]);
-        off2 += e * e;
-      }
-      off[k] = std::sqrt(off2);
-      cell[k] = ci[0] + ci[1] * bc.sy + ci[2] * bc.sz;
-      const double reach = double(cellData[2 * cell[k]]) + noWall;
-      fast[k] |= std::int64_t(off[k] + length[k] < reach);
-      notCleared += 1 - fast[k];
-    }
-    return notCleared;
-  };
   std::int64_t pending = 0;
   const std::int32_t* startCell = L.cell;
   const double halfDiagonal = bc.halfDiagonal;
@@ -96,7 +73,27 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   }
   // The sharper per-point bound where the cells are not known, and near draft plates, whose test below
   // takes the distance from the centre.
-  if (!startCell || (pending > 0 && bc.plateReach)) pending = pointBound();
+  if (!startCell || (pending > 0 && bc.plateReach)) {
+    pending = 0;
+#pragma omp simd reduction(+ : pending)
+    for (int k = 0; k < m; ++k) {
+      int ci[3];
+      double off2 = 0.0;
+      const double pk[3] = {x[k], y[k], z[k]};
+      for (int d = 0; d < 3; ++d) {
+        const double t = (pk[d] - bc.origin[d]) * bc.inv[d];
+        const int i = int(t > 0.0 ? t : 0.0);
+        ci[d] = i < bc.last[d] ? i : bc.last[d];
+        const double e = pk[d] - (bc.origin[d] + (double(ci[d]) + 0.5) * bc.spacing[d]);
+        off2 += e * e;
+      }
+      off[k] = std::sqrt(off2);
+      cell[k] = ci[0] + ci[1] * bc.sy + ci[2] * bc.sz;
+      const double reach = double(cellData[2 * cell[k]]) + noWall;
+      fast[k] = fast[k] | std::int64_t(off[k] + length[k] < reach);
+      pending += 1 - fast[k];
+    }
+  }
   // Second test, for moves near a wall: the end at least `margin` inside every half-space of the
   // outline and the z walls, and the whole move farther than the hit band from the draft plates. Then
   // firstIntersection() reports no hit: from a start clear of a wall's band both ends are clear, and
