@@ -28,7 +28,7 @@ class TracerCloud {
   void setVelocity(std::size_t i, const Eigen::Vector3d& v) { vx[i] = v.x(), vy[i] = v.y(), vz[i] = v.z(); }
 
   std::vector<double> x, y, z;     ///< position [m]
-  std::vector<double> vx, vy, vz;  ///< velocity of the last step [m/s] (free flight keeps it)
+  std::vector<double> vx, vy, vz;  ///< velocity of the last step [m/s]; kept only with free_flight, its one reader (0 otherwise)
   double particlesPerTracer = 1.0; ///< real particles represented by one tracer [-]
   double particleVolume = 0.0;     ///< volume of one real particle [m3]
 };
