@@ -260,106 +260,122 @@ void MotionKernel::move(TracerContext& ctx) {
   const float* cellData = cellData_.data();
   const bool vectorised = settings_.vectorised;
   // Dynamic chunks of blocks: sub-stepped and near-wall tracers cluster (in the spout, at the walls), so
-  // equal shares of blocks are not equal work. The blocks themselves, and integer counters, keep the
-  // results independent of which thread moves which block.
-#pragma omp parallel for schedule(dynamic, 16) reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests) if (n > kParallelThreshold)
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    const std::int64_t i0 = b * kBlock;
-    const int count = int(std::min<std::int64_t>(kBlock, n - i0));
+  // equal shares of blocks are not equal work. Lanes with sub-steps left after their first are
+  // deferred to the end of their chunk (or until 64 have gathered) and move together. Blocks and chunks
+  // are fixed and counters are integers, so results do not depend on which thread moves which chunk.
+  bc.cloudX = px, bc.cloudY = py, bc.cloudZ = pz, bc.cloudVx = pvx, bc.cloudVy = pvy, bc.cloudVz = pvz;
+  bc.keepVelocity = settings_.freeFlight;
+  constexpr std::int64_t kChunk = 16;  // blocks
+  const std::int64_t chunks = (blocks + kChunk - 1) / kChunk;
+#pragma omp parallel for schedule(dynamic, 1) if (n > kParallelThreshold) \
+    reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests)
+  for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {
     MotionStatistics st;
-    alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
-    alignas(64) double speed[kBlock];
-    alignas(64) std::int32_t cellOf[kBlock];
-    std::int64_t free[kBlock];  // free flight (not bool, which stops the vectoriser)
-    // Cells, then their Eq. (10) speed: independent loads the vectorised loop issues as gathers, so
-    // their cache misses overlap.
-    if (haveTracerAlpha) {
-      for (int k = 0; k < count; ++k) cellOf[k] = ctx.tracerCell[std::size_t(i0 + k)];
-    } else {
-      for (int k = 0; k < count; ++k) cellOf[k] = std::int32_t(grid_.flatIndexOf(cloud.position(std::size_t(i0 + k))));
-    }
-    std::int64_t freeLanes = 0;
-    if (settings_.freeFlight) {
-      for (int k = 0; k < count; ++k) {
-        free[k] = sampler.alphaP(cellOf[k]) < settings_.freeFlightAlpha;
-        freeLanes += free[k];
+    DeferredLanes deferred, deferredFree;
+    BlockStencils stencils;
+    for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
+      const std::int64_t i0 = b * kBlock;
+      const int count = int(std::min<std::int64_t>(kBlock, n - i0));
+      alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
+      alignas(64) double speed[kBlock];
+      alignas(64) std::int32_t cellOf[kBlock];
+      std::int64_t free[kBlock];  // free flight (not bool, which stops the vectoriser)
+      // Cells, then their Eq. (10) speed: independent loads the vectorised loop issues as gathers, so
+      // their cache misses overlap.
+      if (haveTracerAlpha) {
+        for (int k = 0; k < count; ++k) cellOf[k] = ctx.tracerCell[std::size_t(i0 + k)];
+      } else {
+        for (int k = 0; k < count; ++k) cellOf[k] = std::int32_t(grid_.flatIndexOf(cloud.position(std::size_t(i0 + k))));
       }
-    } else {
-      for (int k = 0; k < count; ++k) free[k] = 0;
-    }
-#pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      speed[k] = double(cellData[2 * cellOf[k] + 1]) * double(1 - free[k]);  // none in free flight
-    }
-    // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
-    if (fluctuate) {
-#pragma omp simd
-      for (int k = 0; k < count; ++k) {
-        double nx, ny, nz;
-        counterUnitVector(rngPrefix, std::uint64_t(i0 + k), nx, ny, nz);
-        ax[k] = speed[k] * nx, ay[k] = speed[k] * ny, az[k] = speed[k] * nz;
-      }
-    } else {
-      for (int k = 0; k < count; ++k) ax[k] = ay[k] = az[k] = 0.0;
-    }
-    if (!vectorised) {
-      for (int k = 0; k < count; ++k) {
-        moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
-        ++st.scalarPath;
-      }
-    } else {
-      // The lanes that follow u_P^rec: all of them, in place in the cloud's arrays (the velocity arrays
-      // hold u as it is computed), unless some are in free flight.
-      alignas(64) double h[kBlock];
-      alignas(64) std::int32_t left[kBlock];
-      // Lanes in free flight (or not) copied out of the cloud, and back (blocks with both kinds only).
-      auto takeLanes = [&](bool freeFlying, LaneStorage& ls) {
-        int j = 0;
+      std::int64_t freeLanes = 0;
+      if (settings_.freeFlight) {
         for (int k = 0; k < count; ++k) {
-          if ((free[k] != 0) != freeFlying) continue;
-          ls.x[j] = px[i0 + k], ls.y[j] = py[i0 + k], ls.z[j] = pz[i0 + k];
-          ls.ux[j] = pvx[i0 + k], ls.uy[j] = pvy[i0 + k], ls.uz[j] = pvz[i0 + k];  // free flight's own velocity
-          ls.ax[j] = freeFlying ? 0.0 : ax[k], ls.ay[j] = freeFlying ? 0.0 : ay[k], ls.az[j] = freeFlying ? 0.0 : az[k];
-          ls.cell[j] = cellOf[k];
-          ls.lane[j++] = k;
+          free[k] = sampler.alphaP(cellOf[k]) < settings_.freeFlightAlpha;
+          freeLanes += free[k];
         }
-        return ls.view(j, true);
-      };
-      auto putBack = [&](const Lanes& lanes, const LaneStorage& ls) {
-        for (int j = 0; j < lanes.count; ++j) {
-          const std::int64_t i = i0 + ls.lane[j];
-          px[i] = lanes.x[j], py[i] = lanes.y[j], pz[i] = lanes.z[j];
-          pvx[i] = lanes.ux[j], pvy[i] = lanes.uy[j], pvz[i] = lanes.uz[j];
+      } else {
+        for (int k = 0; k < count; ++k) free[k] = 0;
+      }
+  #pragma omp simd
+      for (int k = 0; k < count; ++k) {
+        speed[k] = double(cellData[2 * cellOf[k] + 1]) * double(1 - free[k]);  // none in free flight
+      }
+      // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
+      if (fluctuate) {
+  #pragma omp simd
+        for (int k = 0; k < count; ++k) {
+          double nx, ny, nz;
+          counterUnitVector(rngPrefix, std::uint64_t(i0 + k), nx, ny, nz);
+          ax[k] = speed[k] * nx, ay[k] = speed[k] * ny, az[k] = speed[k] * nz;
         }
-      };
-      LaneStorage compact;
-      // Velocities are kept in the cloud only for free flight, the one reader; otherwise they stay in the
-      // block (saves writing 24 bytes per tracer-step).
-      alignas(64) double sux[kBlock], suy[kBlock], suz[kBlock];
-      const bool keep = settings_.freeFlight;
-      Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, keep ? pvx + i0 : sux, keep ? pvy + i0 : suy, keep ? pvz + i0 : suz,
-              h, left, count, cellOf};
-      if (freeLanes > 0) L = takeLanes(false, compact);
-      const int m = L.count;
-      // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
-      BlockStencils stencils;
-      locateBlock(bc.q, m, L.x, L.y, L.z, stencils);
-      sampleBlock(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
-      auto countSubsteps = [&](Lanes& lanes) {
-        return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
-                               double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);
-      };
-      advanceLanes(L, countSubsteps(L), stencils, false, bc, st);
-      if (freeLanes > 0) {
-        putBack(L, compact);
-        // Free flight: the tracers' own velocities, sub-stepped by them.
-        LaneStorage fs;
-        Lanes F = takeLanes(true, fs);
-        st.freeFlight += F.count;
-        advanceLanes(F, countSubsteps(F), stencils, true, bc, st);
-        putBack(F, fs);
+      } else {
+        for (int k = 0; k < count; ++k) ax[k] = ay[k] = az[k] = 0.0;
+      }
+      if (!vectorised) {
+        for (int k = 0; k < count; ++k) {
+          moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+          ++st.scalarPath;
+        }
+      } else {
+        // The lanes that follow u_P^rec: all of them, in place in the cloud's arrays (the velocity arrays
+        // hold u as it is computed), unless some are in free flight.
+        alignas(64) double h[kBlock];
+        alignas(64) std::int32_t left[kBlock];
+        // Lanes in free flight (or not) copied out of the cloud, and back (blocks with both kinds only).
+        auto takeLanes = [&](bool freeFlying, LaneStorage& ls) {
+          int j = 0;
+          for (int k = 0; k < count; ++k) {
+            if ((free[k] != 0) != freeFlying) continue;
+            ls.x[j] = px[i0 + k], ls.y[j] = py[i0 + k], ls.z[j] = pz[i0 + k];
+            ls.ux[j] = pvx[i0 + k], ls.uy[j] = pvy[i0 + k], ls.uz[j] = pvz[i0 + k];  // free flight's own velocity
+            ls.ax[j] = freeFlying ? 0.0 : ax[k], ls.ay[j] = freeFlying ? 0.0 : ay[k], ls.az[j] = freeFlying ? 0.0 : az[k];
+            ls.cell[j] = cellOf[k];
+            ls.lane[j++] = k;
+          }
+          return ls.view(j, true);
+        };
+        auto putBack = [&](const Lanes& lanes, const LaneStorage& ls) {
+          for (int j = 0; j < lanes.count; ++j) {
+            const std::int64_t i = i0 + ls.lane[j];
+            px[i] = lanes.x[j], py[i] = lanes.y[j], pz[i] = lanes.z[j];
+            pvx[i] = lanes.ux[j], pvy[i] = lanes.uy[j], pvz[i] = lanes.uz[j];
+          }
+        };
+        LaneStorage compact;
+        // Velocities are kept in the cloud only for free flight, the one reader; otherwise they stay in the
+        // block (saves writing 24 bytes per tracer-step).
+        alignas(64) double sux[kBlock], suy[kBlock], suz[kBlock];
+        const bool keep = settings_.freeFlight;
+        Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, keep ? pvx + i0 : sux, keep ? pvy + i0 : suy,
+                keep ? pvz + i0 : suz, h, left, count, cellOf};
+        if (freeLanes > 0) L = takeLanes(false, compact);
+        const int m = L.count;
+        // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
+        locateBlock(bc.q, m, L.x, L.y, L.z, stencils);
+        sampleBlock(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+        auto countSubsteps = [&](Lanes& lanes) {
+          return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
+                                 double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);
+        };
+        const bool more = countSubsteps(L) > 0;
+        subStep(L, stencils, true, bc, st);
+        // Copied back before deferring: deferring may finish lanes, whose results must not be overwritten.
+        if (freeLanes > 0) putBack(L, compact);
+        if (more) defer(L, i0, freeLanes > 0 ? compact.lane : nullptr, deferred, false, stencils, bc, st);
+        if (freeLanes > 0) {
+          // Free flight: the tracers' own velocities, sub-stepped by them.
+          LaneStorage fs;
+          Lanes F = takeLanes(true, fs);
+          st.freeFlight += F.count;
+          const bool moreFree = countSubsteps(F) > 0;
+          freeFlightSubStep(F, stencils, bc, st);
+          putBack(F, fs);
+          if (moreFree) defer(F, i0, fs.lane, deferredFree, true, stencils, bc, st);
+        }
       }
     }
+    finishDeferred(deferred, false, stencils, bc, st);
+    finishDeferred(deferredFree, true, stencils, bc, st);
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
     scalarPath += st.scalarPath, exactWallTests += st.exactWallTests;
   }

@@ -17,6 +17,7 @@ namespace rcfd {
 namespace block {
 struct BlockStencils;
 struct Context;
+struct DeferredLanes;
 struct Lanes;
 }  // namespace block
 
@@ -51,9 +52,16 @@ class MotionKernel {
   /// Builds the step's velocity fields and cell table from the context's frames and tracer alpha_P.
   void prepare(const TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
   // The block path (MotionKernelBlock.cpp).
-  /// All sub-steps of a block's lanes, the first for every lane, then the lanes with more, compacted.
+  /// The sub-steps after the first of lanes: rounds on the lanes that still have some, compacted.
   void advanceLanes(block::Lanes& lanes, std::int32_t maxLeft, block::BlockStencils& stencils, bool freeFlying,
                     const block::Context& bc, MotionStatistics& st) const;
+  /// Adds the lanes with sub-steps left (lane k is tracer i0 + k, or i0 + laneOf[k]) to `deferred`,
+  /// finishing its lanes whenever it is full.
+  void defer(const block::Lanes& lanes, std::int64_t i0, const std::int32_t* laneOf, block::DeferredLanes& deferred,
+             bool freeFlying, block::BlockStencils& stencils, const block::Context& bc, MotionStatistics& st) const;
+  /// The remaining sub-steps of deferred lanes, then their positions (and velocities) into the cloud.
+  void finishDeferred(block::DeferredLanes& deferred, bool freeFlying, block::BlockStencils& stencils,
+                      const block::Context& bc, MotionStatistics& st) const;
   /// One sub-step of lanes along u_P^rec + u_fluc (sampled at the start already when `sampled`).
   void subStep(block::Lanes& lanes, block::BlockStencils& stencils, bool sampled, const block::Context& bc,
                MotionStatistics& st) const;

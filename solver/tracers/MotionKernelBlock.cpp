@@ -1,6 +1,7 @@
 // The motion kernel's block path: lanes of a block of tracers sub-stepped together in loops the
 // compiler vectorises, with the scalar path's arithmetic (MotionKernel.cpp), so both give the same
 // trajectories.
+#include <algorithm>
 #include <cmath>
 
 #include "tracers/BlockLanes.hpp"
@@ -168,16 +169,10 @@ void MotionKernel::freeFlightSubStep(block::Lanes& F, block::BlockStencils& s, c
 void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::BlockStencils& s, bool freeFlying,
                                 const block::Context& bc, MotionStatistics& st) const {
   const int m = L.count;
-  if (freeFlying) {
-    freeFlightSubStep(L, s, bc, st);
-  } else {
-    subStep(L, s, true, bc, st);  // the caller sampled the start to count the sub-steps
-  }
-  // Further sub-steps (fast tracers, mostly in the spout): the lanes that still have some, compacted.
   for (std::int32_t round = 1; round <= maxLeft; ++round) {
     LaneStorage rs;
     int r = 0;
-    for (int k = 0; k < m; ++k) {  // without branches: few lanes have sub-steps left, at random
+    for (int k = 0; k < m; ++k) {  // without branches: which lanes have sub-steps left is irregular
       rs.lane[r] = k;
       r += L.left[k] > 0;
     }
@@ -201,6 +196,38 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
       L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
     }
   }
+}
+
+void MotionKernel::defer(const block::Lanes& L, std::int64_t i0, const std::int32_t* laneOf, block::DeferredLanes& d,
+                         bool freeFlying, block::BlockStencils& s, const block::Context& bc,
+                         MotionStatistics& st) const {
+  for (int k = 0; k < L.count; ++k) {
+    if (L.left[k] <= 0) continue;
+    if (d.count == kBlock) finishDeferred(d, freeFlying, s, bc, st);
+    const int j = d.count++;
+    LaneStorage& ds = d.s;
+    ds.x[j] = L.x[k], ds.y[j] = L.y[k], ds.z[j] = L.z[k];
+    ds.ax[j] = L.ax[k], ds.ay[j] = L.ay[k], ds.az[j] = L.az[k];
+    ds.ux[j] = L.ux[k], ds.uy[j] = L.uy[k], ds.uz[j] = L.uz[k];
+    ds.h[j] = L.h[k];
+    ds.left[j] = L.left[k];
+    d.tracer[j] = i0 + (laneOf ? laneOf[k] : k);
+  }
+}
+
+void MotionKernel::finishDeferred(block::DeferredLanes& d, bool freeFlying, block::BlockStencils& s,
+                                  const block::Context& bc, MotionStatistics& st) const {
+  if (d.count == 0) return;
+  Lanes D = d.s.view(d.count);
+  std::int32_t maxLeft = 0;
+  for (int j = 0; j < d.count; ++j) maxLeft = std::max(maxLeft, d.s.left[j]);
+  advanceLanes(D, maxLeft, s, freeFlying, bc, st);
+  for (int j = 0; j < d.count; ++j) {
+    const std::int64_t i = d.tracer[j];
+    bc.cloudX[i] = D.x[j], bc.cloudY[i] = D.y[j], bc.cloudZ[i] = D.z[j];
+    if (bc.keepVelocity) bc.cloudVx[i] = D.ux[j], bc.cloudVy[i] = D.uy[j], bc.cloudVz[i] = D.uz[j];
+  }
+  d.count = 0;
 }
 
 }  // namespace rcfd
