@@ -260,8 +260,10 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   if (!std::filesystem::exists(path)) throw InputError(path, "", "file does not exist");
   if (H5Fis_hdf5(path.c_str()) <= 0) throw InputError(path, "", "not an HDF5 file");
   auto reader = std::make_unique<FrameReader>();
-  reader->file = Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
-  if (!reader->file.valid()) throw InputError(path, "", "cannot be opened as HDF5 (damaged or locked)");
+  reader->file = Handle(hdf5::openReadOnlyWaitingForWriter(path));
+  if (!reader->file.valid()) {
+    throw InputError(path, "", "cannot be opened as HDF5 (damaged, or held open for writing for over a minute)");
+  }
   Header h = readHeader(reader->file, path);
   reader->grid = h.grid;
   reader->path = path;

@@ -1,8 +1,36 @@
 #include "fields/Hdf5.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <thread>
+
 #include "core/Errors.hpp"
 
 namespace rcfd::hdf5 {
+
+namespace {
+/// True while some process holds an exclusive flock on the file (HDF5's lock of a writer).
+bool lockedByWriter(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool locked = ::flock(fd, LOCK_SH | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);  // also releases the shared lock if it was taken
+  return locked;
+}
+}  // namespace
+
+hid_t openReadOnlyWaitingForWriter(const std::string& path, double patienceSeconds) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(patienceSeconds);
+  for (;;) {
+    const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (id >= 0 || !lockedByWriter(path) || std::chrono::steady_clock::now() >= deadline) return id;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
 
 void Handle::reset() {
   if (id_ < 0) return;

@@ -46,6 +46,12 @@ class Handle {
 /// Turns HDF5's automatic error-stack printing off (errors are reported through rcfd exceptions).
 void silenceErrors();
 
+/// H5Fopen(path, read-only). While another process holds the file open for writing (HDF5's file lock,
+/// an exclusive flock: a job storing its recurrence matrix in a database others also read), waits and
+/// tries again, for up to `patienceSeconds`; a file that fails to open for any other reason fails at
+/// once. Returns the file identifier, negative on failure.
+hid_t openReadOnlyWaitingForWriter(const std::string& path, double patienceSeconds = 60.0);
+
 /// Throws rcfd::RunError("what: HDF5 call failed") when `id` is negative; returns the owned handle.
 Handle check(hid_t id, const std::string& what);
 /// Throws rcfd::RunError when an herr_t status is negative.

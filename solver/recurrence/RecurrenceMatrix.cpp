@@ -410,7 +410,7 @@ void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatr
 std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
   using hdf5::Handle;
   hdf5::silenceErrors();
-  Handle file(H5Fopen(databasePath.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  Handle file(hdf5::openReadOnlyWaitingForWriter(databasePath));
   if (!file.valid() || !hdf5::linkExists(file, layout::recurrenceMatrix)) return std::nullopt;
   Handle set(H5Dopen2(file, layout::recurrenceMatrix, H5P_DEFAULT));
   if (!set.valid() || hdf5::datasetClass(set) != H5T_FLOAT) return std::nullopt;

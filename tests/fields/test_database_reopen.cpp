@@ -5,6 +5,12 @@
 #include "FieldTestUtil.hpp"
 #include "fields/Hdf5.hpp"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+
 using namespace rcfd;
 using namespace rcfd::test;
 
@@ -78,4 +84,43 @@ TEST(FieldDatabaseReopen, RefusesMoreFramesThanStoredAndAnotherGrid) {
   EXPECT_THROW(FieldDatabaseWriter::reopen(tempPath("missing.h5"), g, 0), InputError);
   // The refused attempts left the file as it was.
   EXPECT_EQ(FieldDatabase::open(path)->frameCount(), 3);
+}
+
+// Two jobs on one database: one stores its recurrence matrix (HDF5 holds an exclusive lock on the file
+// while it is open for writing) while the other opens the database. The reader waits for the writer
+// instead of reporting the file as damaged (this failed the end-to-end test at random before).
+TEST(FieldDatabaseReopen, OpeningWaitsWhileAnotherProcessWritesTheFile) {
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  const std::string path = writeWavyDatabase("locked.h5", g, 3);
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t writer = ::fork();
+  ASSERT_GE(writer, 0);
+  if (writer == 0) {  // a real second process, as a second solver would be
+    const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const char byte = f >= 0 ? 1 : 0;
+    (void)!::write(ready[1], &byte, 1);
+    ::usleep(400000);
+    if (f >= 0) H5Fclose(f);
+    ::_exit(0);
+  }
+  char byte = 0;
+  ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+  ASSERT_EQ(byte, 1) << "the writer could not open the file";
+  const auto start = std::chrono::steady_clock::now();
+  std::shared_ptr<FieldDatabase> db;
+  EXPECT_NO_THROW(db = FieldDatabase::open(path));
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  int status = 0;
+  ::waitpid(writer, &status, 0);
+  ::close(ready[0]), ::close(ready[1]);
+  ASSERT_TRUE(db);
+  EXPECT_EQ(db->frameCount(), 3);
+  EXPECT_GT(waited, 0.2) << "opened while the writer still held the file: the lock was not tested";
+  // A file that is not locked but damaged fails at once, without waiting.
+  const std::string junk = tempPath("junk.h5");
+  { std::ofstream(junk) << "\x89HDF\r\n\x1a\n" << std::string(64, '\0'); }
+  const auto junkStart = std::chrono::steady_clock::now();
+  EXPECT_THROW(FieldDatabase::open(junk), InputError);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - junkStart).count(), 1.0);
 }
