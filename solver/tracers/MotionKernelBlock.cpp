@@ -201,8 +201,14 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
 void MotionKernel::defer(const block::Lanes& L, std::int64_t i0, const std::int32_t* laneOf, block::DeferredLanes& d,
                          bool freeFlying, block::BlockStencils& s, const block::Context& bc,
                          MotionStatistics& st) const {
-  for (int k = 0; k < L.count; ++k) {
-    if (L.left[k] <= 0) continue;
+  std::int32_t lanes[kBlock];
+  int r = 0;
+  for (int k = 0; k < L.count; ++k) {  // without branches, as in advanceLanes
+    lanes[r] = k;
+    r += L.left[k] > 0;
+  }
+  for (int q = 0; q < r; ++q) {
+    const int k = lanes[q];
     if (d.count == kBlock) finishDeferred(d, freeFlying, s, bc, st);
     const int j = d.count++;
     LaneStorage& ds = d.s;
