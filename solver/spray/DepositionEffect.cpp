@@ -8,6 +8,8 @@
 //
 // Determinism: per-parcel efficiencies run in parallel; the books, the per-cell carry and the random
 // hand-out run in parcel, cell and tracer order with counter-based random numbers keyed by (cell, step).
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -22,6 +24,7 @@ namespace rcfd {
 namespace {
 
 constexpr double kMinDropletsPerParcel = 1.0;  ///< N_D,min of the paper
+constexpr std::int64_t kPicksPerBinomial = 32;  ///< see DepositionEffect::distribute
 
 class DepositionEffect final : public TracerEffect {
  public:
@@ -36,12 +39,13 @@ class DepositionEffect final : public TracerEffect {
     state_->cellPending.assign(std::size_t(ctx.grid.cellCount()), 0.0);
     state_->tracerDroplets.assign(ctx.cloud.size(), 0.0);
     due_.assign(std::size_t(ctx.grid.cellCount()), 0);
+    slot_.assign(std::size_t(ctx.grid.cellCount()), -1);
   }
 
   std::size_t allocatedBytes() const override {
     return (state_->cellDeposit.capacity() + state_->cellPending.capacity() + state_->tracerDroplets.capacity()) *
                sizeof(double) +
-           due_.capacity() * sizeof(std::int32_t);
+           (due_.capacity() + slot_.capacity()) * sizeof(std::int32_t);
   }
 
   void afterMove(TracerContext& ctx) override {
@@ -125,45 +129,71 @@ class DepositionEffect final : public TracerEffect {
       if (s.cellPending[std::size_t(c)] > 0.0) waiting_.push_back(c);
     }
     if (dueTotal == 0) return;
-    // Tracers of the cells with droplets due, in tracer order.
-    members_.clear();
-    memberCell_.clear();
-    const std::int64_t n = std::int64_t(ctx.cloud.size());
-    for (std::int64_t i = 0; i < n; ++i) {
-      const std::int32_t c = ctx.tracerCell[std::size_t(i)];
+    // The cells with droplets due, in cell order, each a slot; then their tracers grouped by slot, in
+    // tracer order within a slot: one pass over all tracers in contiguous ranges (in parallel), the
+    // few members of each range kept in range order, then a stable counting sort by slot. The order
+    // is the same for any thread count.
+    slotCells_.clear();
+    for (const std::int32_t c : touched_) {
       if (due_[std::size_t(c)] > 0) {
-        members_.push_back(std::int32_t(i));
-        memberCell_.push_back(c);
+        slot_[std::size_t(c)] = std::int32_t(slotCells_.size());
+        slotCells_.push_back(c);
       }
     }
-    // Group by cell (stable: tracer order within a cell) and hand out.
-    std::vector<std::size_t> order(members_.size());
-    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t a, std::size_t b) { return memberCell_[a] < memberCell_[b]; });
-    for (std::size_t start = 0; start < order.size();) {
-      const std::int32_t c = memberCell_[order[start]];
-      std::size_t end = start;
-      while (end < order.size() && memberCell_[order[end]] == c) ++end;
+    const std::size_t slots = slotCells_.size();
+    const std::int64_t n = std::int64_t(ctx.cloud.size());
+    const bool parallel = n > kParallelThreshold;
+    const int threads = parallel ? omp_get_max_threads() : 1;
+    const std::int32_t* cellOf = ctx.tracerCell.data();
+    const std::int32_t* slotOf = slot_.data();
+    found_.resize(std::size_t(threads));
+    int team = 1;  // a team may be smaller than asked for (nested inside a calibration's threads)
+#pragma omp parallel num_threads(threads) if (parallel)
+    {
+      const int used = omp_get_num_threads(), t = omp_get_thread_num();
+#pragma omp single nowait
+      team = used;
+      const std::int64_t first = n * t / used, last = n * (t + 1) / used;
+      auto& mine = found_[std::size_t(t)];
+      mine.clear();
+      for (std::int64_t i = first; i < last; ++i) {
+        if (slotOf[cellOf[i]] >= 0) mine.push_back(std::int32_t(i));
+      }
+    }
+    found_.resize(std::size_t(team));
+    slotStart_.assign(slots + 1, 0);
+    for (const auto& range : found_) {
+      for (const std::int32_t i : range) ++slotStart_[std::size_t(slotOf[cellOf[i]]) + 1];
+    }
+    for (std::size_t k = 0; k < slots; ++k) slotStart_[k + 1] += slotStart_[k];
+    members_.resize(std::size_t(slotStart_[slots]));
+    cursor_.assign(slotStart_.begin(), slotStart_.end() - 1);
+    for (const auto& range : found_) {
+      for (const std::int32_t i : range) members_[std::size_t(cursor_[std::size_t(slotOf[cellOf[i]])]++)] = i;
+    }
+    for (std::size_t k = 0; k < slots; ++k) {
+      const std::int32_t c = slotCells_[k];
+      slot_[std::size_t(c)] = -1;
       CounterRng rng(ctx.seed, RngPurpose::Deposition, std::uint64_t(c), std::uint64_t(ctx.step));
-      distribute(rng, std::int64_t(due_[std::size_t(c)]), start, end, order, s.tracerDroplets);
+      distribute(rng, std::int64_t(due_[std::size_t(c)]), std::size_t(slotStart_[k]), std::size_t(slotStart_[k + 1]),
+                 s.tracerDroplets);
       s.assigned += double(due_[std::size_t(c)]);
       due_[std::size_t(c)] = 0;
-      start = end;
     }
   }
 
-  /// Hands `droplets` whole droplets to the tracers order[start, end) with equal probability each: a
-  /// multinomial draw. Few droplets: one uniform pick per droplet; many: sequential binomials, so the
-  /// cost is bounded by the number of tracers, not of droplets (compressed-time tests deposit 1e7 per
-  /// step).
+  /// Hands `droplets` whole droplets to the tracers members_[start, end) with equal probability each: a
+  /// multinomial draw. Up to kPicksPerBinomial droplets per tracer: one uniform pick per droplet; more:
+  /// sequential binomials, so the cost is bounded by the number of tracers, not of droplets
+  /// (compressed-time tests deposit 1e7 per step). Both are exact; the switch sits where their costs
+  /// meet (a std::binomial_distribution is set up per tracer, about as dear as 30 picks).
   void distribute(CounterRng& rng, std::int64_t droplets, std::size_t start, std::size_t end,
-                  const std::vector<std::size_t>& order, std::vector<double>& collected) const {
+                  std::vector<double>& collected) const {
     const std::size_t k = end - start;
-    if (droplets <= std::int64_t(k)) {
+    if (droplets <= kPicksPerBinomial * std::int64_t(k)) {
       for (std::int64_t d = 0; d < droplets; ++d) {
         const std::size_t pick = std::min(end - 1, start + std::size_t(rng.uniform() * double(k)));
-        collected[std::size_t(members_[order[pick]])] += 1.0;
+        collected[std::size_t(members_[pick])] += 1.0;
       }
       return;
     }
@@ -176,7 +206,7 @@ class DepositionEffect final : public TracerEffect {
         std::binomial_distribution<std::int64_t> binomial(left, 1.0 / double(remaining));
         take = binomial(urbg);
       }
-      collected[std::size_t(members_[order[m]])] += double(take);
+      collected[std::size_t(members_[m])] += double(take);
       left -= take;
     }
   }
@@ -196,7 +226,12 @@ class DepositionEffect final : public TracerEffect {
   std::vector<std::int32_t> due_;       ///< whole droplets due per cell this step
   std::vector<std::int32_t> touched_;   ///< cells with new or pending droplets this step
   std::vector<std::int32_t> waiting_;   ///< cells keeping a fraction of a droplet
-  std::vector<std::int32_t> members_, memberCell_;
+  std::vector<std::int32_t> members_;     ///< tracers of the cells with droplets due, grouped by cell
+  std::vector<std::int32_t> slot_;        ///< per cell: its slot this step, or -1
+  std::vector<std::int32_t> slotCells_;   ///< cells with droplets due, in cell order
+  std::vector<std::int64_t> slotStart_;   ///< members_ of slot k: [slotStart_[k], slotStart_[k + 1])
+  std::vector<std::int64_t> cursor_;      ///< per slot: the next write position in members_
+  std::vector<std::vector<std::int32_t>> found_;  ///< per thread: members found in its range of tracers
   bool pendingCellsKnown_ = false;
 };
 
