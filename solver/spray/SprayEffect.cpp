@@ -140,7 +140,7 @@ class SprayEffect final : public TracerEffect {
     std::vector<std::int8_t> exit(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
     const FrameSampler sampler = ctx.sampler();
     const double dt = ctx.dt;
-#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
+#pragma omp parallel for schedule(dynamic, 64) if (n > kParallelThreshold)  // sub-steps vary: dynamic
     for (std::int64_t j = 0; j < n; ++j) {
       Eigen::Vector3d p = pc.position(std::size_t(j));
       Eigen::Vector3d u = sampler.velocity(p, true);

@@ -1,6 +1,3 @@
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include "tracers/TracerSimulation.hpp"
 
 #include <algorithm>
@@ -138,7 +135,7 @@ void TracerSimulation::step() {
   auto& ctx = *context_;
   for (auto& e : effects_) e->beforeMove(ctx);
   kernel_->move(ctx);
-  for (std::size_t ei = 0; ei < effects_.size(); ++ei) { auto a = std::chrono::steady_clock::now(); effects_[ei]->afterMove(ctx); if (getenv("PH_EFF")) fprintf(stderr, "A %s %.3f\n", effectNames_[ei].c_str(), std::chrono::duration<double>(std::chrono::steady_clock::now()-a).count()*1e3); }
+  for (auto& e : effects_) e->afterMove(ctx);
   ++ctx.step;
   loadFrames();
 }
