@@ -21,7 +21,9 @@ class TracerVolumeFractionEffect final : public TracerEffect {
     bytes_ = ctx.tracerCell.size() * sizeof(std::int32_t) + ctx.tracerCount.size() * sizeof(std::int32_t) +
              ctx.tracerAlpha.size() * sizeof(float);
   }
-  std::size_t allocatedBytes() const override { return bytes_ + partial_.capacity() * sizeof(std::int32_t); }
+  std::size_t allocatedBytes() const override {
+    return bytes_ + partial_.capacity() * sizeof(std::int32_t) + alphaPerTracer_.capacity() * sizeof(double);
+  }
 
   void beforeMove(TracerContext& ctx) override {
     const auto& cloud = ctx.cloud;
@@ -76,19 +78,35 @@ class TracerVolumeFractionEffect final : public TracerEffect {
       for (std::int64_t i = 0; i < n; ++i) ++histogram[cellOut[i]];
     }
     const int others = used - 1;
-    const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
-#pragma omp parallel for schedule(static) if (cells > kParallelThreshold)
-    for (std::int64_t c = 0; c < cells; ++c) {
-      for (int t = 0; t < others; ++t) count[std::size_t(c)] += partial_[std::size_t(t) * std::size_t(cells) + std::size_t(c)];
-      const double open = ctx.openVolume[std::size_t(c)];
-      ctx.tracerAlpha[std::size_t(c)] =
-          open > 0.0 ? float(count[std::size_t(c)] * volumePerTracer / open) : 0.0f;
+    if (alphaPerTracer_.empty()) {
+      // alpha_P of one tracer in each cell: its particles' volume over the open volume (0 where closed).
+      const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
+      alphaPerTracer_.resize(std::size_t(cells));
+      for (std::int64_t c = 0; c < cells; ++c) {
+        const double open = ctx.openVolume[std::size_t(c)];
+        alphaPerTracer_[std::size_t(c)] = open > 0.0 ? volumePerTracer / open : 0.0;
+      }
+    }
+    std::int32_t* total = count.data();
+    const double* perTracer = alphaPerTracer_.data();
+    float* alpha = ctx.tracerAlpha.data();
+    // Plain loops over cells, which vectorise (a loop over the threads inside them did not).
+#pragma omp parallel if (cells > kParallelThreshold)
+    {
+      for (int t = 0; t < others; ++t) {
+        const std::int32_t* part = partial_.data() + std::size_t(t) * std::size_t(cells);
+#pragma omp for simd schedule(static)
+        for (std::int64_t c = 0; c < cells; ++c) total[c] += part[c];
+      }
+#pragma omp for simd schedule(static)
+      for (std::int64_t c = 0; c < cells; ++c) alpha[c] = float(double(total[c]) * perTracer[c]);
     }
   }
 
  private:
   std::size_t bytes_ = 0;
   std::vector<std::int32_t> partial_;  ///< histograms of threads 1.. (thread 0 counts into tracerCount)
+  std::vector<double> alphaPerTracer_; ///< per cell: alpha_P of one tracer [-]
 };
 
 const bool registered = TracerEffectRegistry::add(
