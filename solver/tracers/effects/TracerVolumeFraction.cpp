@@ -33,12 +33,21 @@ class TracerVolumeFractionEffect final : public TracerEffect {
     const bool parallel = n > kParallelThreshold;
     const int threads = parallel ? omp_get_max_threads() : 1;
     partial_.resize(std::size_t(threads - 1) * std::size_t(cells));
-    int used = 1;  // a team may be smaller than asked for (nested inside a calibration's threads)
+    if (alphaPerTracer_.empty()) {
+      // alpha_P of one tracer in each cell: its particles' volume over the open volume (0 where closed).
+      const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
+      alphaPerTracer_.resize(std::size_t(cells));
+      for (std::int64_t c = 0; c < cells; ++c) {
+        const double open = ctx.openVolume[std::size_t(c)];
+        alphaPerTracer_[std::size_t(c)] = open > 0.0 ? volumePerTracer / open : 0.0;
+      }
+    }
+    // One parallel region (each is a fork and a join): cells and counts of the tracers, block by block;
+    // then, after a barrier, the threads' histograms summed and alpha_P, cell by cell.
 #pragma omp parallel if (parallel) num_threads(threads)
     {
       const int t = omp_get_thread_num();
-#pragma omp single
-      used = omp_get_num_threads();
+      const int others = omp_get_num_threads() - 1;  // a team may be smaller than asked for
       std::int32_t* histogram = t == 0 ? count.data() : partial_.data() + std::size_t(t - 1) * std::size_t(cells);
       std::fill(histogram, histogram + cells, 0);
       // The cell of every tracer, on plain locals, which vectorises.
@@ -73,28 +82,15 @@ class TracerVolumeFractionEffect final : public TracerEffect {
           ck = ck < 0 ? 0 : (ck >= nz ? nz - 1 : ck);
           out[k] = (ck * ny + cj) * nx + ci;
         }
+        for (int k = 0; k < count; ++k) ++histogram[out[k]];
       }
-#pragma omp for schedule(static)
-      for (std::int64_t i = 0; i < n; ++i) ++histogram[cellOut[i]];
-    }
-    const int others = used - 1;
-    if (alphaPerTracer_.empty()) {
-      // alpha_P of one tracer in each cell: its particles' volume over the open volume (0 where closed).
-      const double volumePerTracer = cloud.particlesPerTracer * cloud.particleVolume;
-      alphaPerTracer_.resize(std::size_t(cells));
-      for (std::int64_t c = 0; c < cells; ++c) {
-        const double open = ctx.openVolume[std::size_t(c)];
-        alphaPerTracer_[std::size_t(c)] = open > 0.0 ? volumePerTracer / open : 0.0;
-      }
-    }
-    std::int32_t* total = count.data();
-    const double* perTracer = alphaPerTracer_.data();
-    float* alpha = ctx.tracerAlpha.data();
-    // Plain loops over cells, which vectorise (a loop over the threads inside them did not).
-#pragma omp parallel if (cells > kParallelThreshold)
-    {
-      for (int t = 0; t < others; ++t) {
-        const std::int32_t* part = partial_.data() + std::size_t(t) * std::size_t(cells);
+      // (the implicit barrier of the loop above: every histogram is complete)
+      std::int32_t* total = count.data();
+      const double* perTracer = alphaPerTracer_.data();
+      float* alpha = ctx.tracerAlpha.data();
+      // Plain loops over cells, which vectorise (a loop over the threads inside them did not).
+      for (int u = 0; u < others; ++u) {
+        const std::int32_t* part = partial_.data() + std::size_t(u) * std::size_t(cells);
 #pragma omp for simd schedule(static)
         for (std::int64_t c = 0; c < cells; ++c) total[c] += part[c];
       }
