@@ -115,16 +115,24 @@ void MotionKernel::prepare(const TracerContext& ctx, const FrameSampler& sampler
   const FluctuationModel* model = fluctuate ? settings_.fluctuation : nullptr;
   if (!model && !hadSpeeds_) return;
   hadSpeeds_ = model != nullptr;
+  // Eq. (10), once per cell instead of once per tracer: it depends on the cell only. Both models give 0
+  // in a cell without tracers, where no tracer reads it either. Chunks of cells through the model's
+  // vectorised speeds().
   const double dt = ctx.dt;
+  const float* recA = sampler.frame().alpha_p.data();
+  const float* recB = sampler.nextFrame() ? sampler.nextFrame()->alpha_p.data() : nullptr;
+  const double blend = sampler.blend();
+  constexpr std::int64_t kChunk = 2048;
 #pragma omp parallel for schedule(static) if (parallel)
-  for (std::int64_t c = 0; c < cells; ++c) {
-    // Eq. (10), once per cell instead of once per tracer: it depends on the cell only. Both models
-    // give 0 in a cell without tracers, where no tracer reads it either.
-    const float alphaTracer = model ? ctx.tracerAlpha[std::size_t(c)] : 0.0f;
-    cellData_[2 * std::size_t(c) + 1] =
-        alphaTracer > 0.0f
-            ? float(std::min(model->speed(alphaTracer, sampler.alphaP(c), settings_.d0, dt), settings_.uFlucMax))
-            : 0.0f;
+  for (std::int64_t c0 = 0; c0 < cells; c0 += kChunk) {
+    const std::int64_t count = std::min(kChunk, cells - c0);
+    float* out = cellData_.data() + 2 * c0 + 1;
+    if (model) {
+      model->speeds(count, ctx.tracerAlpha.data() + c0, recA + c0, recB ? recB + c0 : nullptr, blend, settings_.d0,
+                    dt, settings_.uFlucMax, out, 2);
+    } else {
+      for (std::int64_t c = 0; c < count; ++c) out[2 * c] = 0.0f;
+    }
   }
 }
 

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "tracers/BlockSampling.hpp"
+#include "tracers/FluctuationModel.hpp"
 #include "tracers/FrameSampler.hpp"
 #include "tracers/SingleSphereDrag.hpp"
 #include "tracers/UnitVectors.hpp"
@@ -227,4 +228,37 @@ TEST(Kernel, VectorisablePowAndDragFactorMatchStdPow) {
   EXPECT_NEAR(singleSphereDragFactor(999.999), 1.0 + 0.15 * std::pow(999.999, 0.687), 1e-11);
   EXPECT_DOUBLE_EQ(singleSphereDragFactor(2000.0), 0.44 * 2000.0 / 24.0);  // Newton
   EXPECT_TRUE(std::isfinite(singleSphereDragFactor(1e300)));
+}
+
+/// The motion kernel takes Eq. (10) speeds from the models' vectorised speeds(); they equal the
+/// per-cell speed() capped at u_fluc_max bit for bit, for both models, with and without a blend of
+/// two frames, over empty, under- and over-packed cells and out-of-range fractions.
+TEST(Kernel, VectorisedFluctuationSpeedsEqualThePerCellOnes) {
+  std::mt19937_64 gen(17);
+  std::uniform_real_distribution<double> fraction(-0.1, 1.1);
+  const std::int64_t n = 5000;
+  std::vector<float> tracer(n), recA(n), recB(n);
+  for (std::int64_t c = 0; c < n; ++c) {
+    tracer[c] = c % 7 == 0 ? 0.0f : float(fraction(gen));
+    recA[c] = float(fraction(gen)), recB[c] = c % 11 == 0 ? recA[c] : float(fraction(gen));
+  }
+  const double d0 = 5e-4, dt = 0.005, cap = 0.05, blend = 0.37;  // LP peaks at 0.073 m/s here
+  for (const std::string name : {"lichtenegger_pirker", "cfdem"}) {
+    const auto model = FluctuationModelRegistry::create(name);
+    for (const bool blended : {false, true}) {
+      std::vector<float> out(2 * n, -1.0f);
+      model->speeds(n, tracer.data(), recA.data(), blended ? recB.data() : nullptr, blended ? blend : 0.0, d0, dt,
+                    cap, out.data() + 1, 2);
+      std::int64_t capped = 0, moving = 0;
+      for (std::int64_t c = 0; c < n; ++c) {
+        const double rec = blended ? double(recA[c]) + blend * (double(recB[c]) - double(recA[c])) : double(recA[c]);
+        const float expected = tracer[c] > 0.0f ? float(std::min(model->speed(tracer[c], rec, d0, dt), cap)) : 0.0f;
+        ASSERT_EQ(out[2 * c + 1], expected) << name << " cell " << c;
+        ASSERT_EQ(out[2 * c], -1.0f);  // the stride is kept
+        capped += out[2 * c + 1] == float(cap), moving += out[2 * c + 1] > 0.0f;
+      }
+      EXPECT_GT(capped, 0) << name;  // the cap was reached, and
+      EXPECT_GT(moving, capped) << name;  // speeds below it occurred
+    }
+  }
 }
