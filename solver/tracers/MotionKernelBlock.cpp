@@ -46,7 +46,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   // inside (signed distances are 1-Lipschitz).
   alignas(64) std::int64_t fast[kBlock];
   alignas(64) double ex[kBlock], ey[kBlock], ez[kBlock];  // end points
-  alignas(64) double off[kBlock], length[kBlock];
+  alignas(64) double off[kBlock], length2[kBlock];  // |p - c|, |disp|^2
   alignas(64) std::int32_t cell[kBlock];
   const float* cellData = bc.cellData;
   const double noWall = bc.noWall;
@@ -57,7 +57,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   for (int k = 0; k < m; ++k) {
     const double dx = h[k] * ux[k], dy = h[k] * uy[k], dz = h[k] * uz[k];
     ex[k] = x[k] + dx, ey[k] = y[k] + dy, ez[k] = z[k] + dz;
-    length[k] = std::sqrt(dx * dx + dy * dy + dz * dz);
+    length2[k] = dx * dx + dy * dy + dz * dz;
   }
   if (startCell) {
     // The lanes' cells are known (the step's first round): the bound with |p - c| <= half a diagonal
@@ -66,7 +66,9 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
     for (int k = 0; k < m; ++k) {
       off[k] = halfDiagonal;
       cell[k] = startCell[k];
-      fast[k] = off[k] + length[k] < double(cellData[2 * cell[k]]) + noWall;
+      // |disp| < reach - off, squared (no square root where most lanes are decided)
+      const double room = double(cellData[2 * cell[k]]) + noWall - off[k];
+      fast[k] = std::int64_t(room > 0.0) & std::int64_t(length2[k] < room * room);
       pending += 1 - fast[k];
     }
   } else {
@@ -91,7 +93,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
       off[k] = std::sqrt(off2);
       cell[k] = ci[0] + ci[1] * bc.sy + ci[2] * bc.sz;
       const double reach = double(cellData[2 * cell[k]]) + noWall;
-      fast[k] = fast[k] | std::int64_t(off[k] + length[k] < reach);
+      fast[k] = fast[k] | std::int64_t(off[k] + std::sqrt(length2[k]) < reach);
       pending += 1 - fast[k];
     }
   }
@@ -105,7 +107,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
     alignas(64) std::int64_t inside[kBlock];
     if (plateReach) {
 #pragma omp simd
-      for (int k = 0; k < m; ++k) inside[k] = off[k] + length[k] < double(plateReach[cell[k]]);
+      for (int k = 0; k < m; ++k) inside[k] = off[k] + std::sqrt(length2[k]) < double(plateReach[cell[k]]);
     } else {
       for (int k = 0; k < m; ++k) inside[k] = 1;
     }
