@@ -7,6 +7,7 @@
 #include <numbers>
 #include <vector>
 
+#include "geometry/WallClearance.hpp"
 #include "spray/SprayState.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/TracerEffect.hpp"
@@ -26,18 +27,10 @@ class SprayEffect final : public TracerEffect {
     cosHalfAngle_ = std::cos(spec_.cone_half_angle_deg * std::numbers::pi / 180.0);
     launchSpread_ = ctx.grid.spacing.minCoeff();
     minSpacing_ = ctx.grid.spacing.minCoeff();
-    // Per cell, a move shorter than this cannot reach a boundary: sd(centre) less half a diagonal (no
-    // point of the cell is farther from the centre; signed distances are 1-Lipschitz) and the band of
-    // firstIntersection(). Most parcel sub-steps then skip the exact test, with the same result.
-    const double halfDiagonal = 0.5 * ctx.grid.spacing.norm();
-    const double band = 2.0 * ctx.apparatus.boundaryTolerance();
-    clearance_.resize(std::size_t(ctx.grid.cellCount()));
-#pragma omp parallel for schedule(static) if (ctx.grid.cellCount() > kParallelThreshold)
-    for (std::int64_t c = 0; c < ctx.grid.cellCount(); ++c) {
-      const auto ijk = ctx.grid.cellIjk(c);
-      const double sd = ctx.apparatus.signedDistance(ctx.grid.cellCenter(ijk[0], ijk[1], ijk[2]));
-      clearance_[std::size_t(c)] = float(std::max(0.0, sd - halfDiagonal - band) * (1.0 - 1e-6));
-    }
+    // Per cell, a move shorter than this cannot reach a boundary; most parcel sub-steps then skip the
+    // exact test, with the same result.
+    clearance_ = cellWallClearance(ctx.apparatus, ctx.grid,
+                                   0.5 * ctx.grid.spacing.norm() + 2.0 * ctx.apparatus.boundaryTolerance());
   }
 
   std::size_t allocatedBytes() const override { return sizeof(SprayState) + clearance_.capacity() * sizeof(float); }

@@ -36,7 +36,26 @@ struct LaneStorage {
   Lanes view(int count, bool withCells = false) {
     return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count, withCells ? cell : nullptr};
   }
+  /// Copies lane k of `from` (position, u_fluc, velocity, sub-step, sub-steps left) into lane j.
+  void copyLane(const Lanes& from, int k, int j) {
+    x[j] = from.x[k], y[j] = from.y[k], z[j] = from.z[k];
+    ax[j] = from.ax[k], ay[j] = from.ay[k], az[j] = from.az[k];
+    ux[j] = from.ux[k], uy[j] = from.uy[k], uz[j] = from.uz[k];
+    h[j] = from.h[k];
+    left[j] = from.left[k];
+  }
 };
+
+/// The lanes of `lanes` with sub-steps left, in lane order, into `out`; returns their number. Without
+/// branches: which lanes they are is irregular.
+inline int lanesWithSubstepsLeft(const Lanes& lanes, std::int32_t* out) {
+  int r = 0;
+  for (int k = 0; k < lanes.count; ++k) {
+    out[r] = k;
+    r += lanes.left[k] > 0;
+  }
+  return r;
+}
 
 /// Lanes, from the blocks of one chunk, with sub-steps left after their first: moved together when the
 /// storage is full or the chunk ends, so later sub-steps run on full vectors rather than on the one or

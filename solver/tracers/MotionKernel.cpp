@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/Errors.hpp"
+#include "geometry/WallClearance.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FluctuationModel.hpp"
 #include "tracers/BlockLanes.hpp"
@@ -33,16 +34,8 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
     // firstIntersection() reports hits, so a move it accepts is one the exact test would not stop.
     const double halfDiagonal = 0.5 * grid_.spacing.norm();
     const double band = 2.0 * apparatus_.boundaryTolerance();
-    clearance_.resize(std::size_t(grid_.cellCount()));
-    reach_.resize(std::size_t(grid_.cellCount()));
-#pragma omp parallel for schedule(static) if (grid_.cellCount() > kParallelThreshold)
-    for (std::int64_t c = 0; c < grid_.cellCount(); ++c) {
-      const auto ijk = grid_.cellIjk(c);
-      const double sd = apparatus_.signedDistance(grid_.cellCenter(ijk[0], ijk[1], ijk[2]));
-      // The factor 1 - 1e-6 covers the rounding to float (6e-8) and of the distances.
-      clearance_[std::size_t(c)] = float(std::max(0.0, sd - halfDiagonal) * (1.0 - 1e-6));
-      reach_[std::size_t(c)] = float(std::max(0.0, sd - band) * (1.0 - 1e-6));
-    }
+    clearance_ = cellWallClearance(apparatus_, grid_, halfDiagonal);
+    reach_ = cellWallClearance(apparatus_, grid_, band);
     halfSpaces_ = apparatus_.convexHalfSpaces();
     // Distance from each cell centre to the draft plates less the band: a move with
     // |p - centre| + |disp| below it cannot reach a plate (the block path's second wall test).

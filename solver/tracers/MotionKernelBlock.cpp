@@ -170,21 +170,12 @@ void MotionKernel::freeFlightSubStep(block::Lanes& F, block::BlockStencils& s, c
 
 void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::BlockStencils& s, bool freeFlying,
                                 const block::Context& bc, MotionStatistics& st) const {
-  const int m = L.count;
   for (std::int32_t round = 1; round <= maxLeft; ++round) {
     LaneStorage rs;
-    int r = 0;
-    for (int k = 0; k < m; ++k) {  // without branches: which lanes have sub-steps left is irregular
-      rs.lane[r] = k;
-      r += L.left[k] > 0;
-    }
+    const int r = lanesWithSubstepsLeft(L, rs.lane);
     for (int j = 0; j < r; ++j) {
-      const int k = rs.lane[j];
-      rs.x[j] = L.x[k], rs.y[j] = L.y[k], rs.z[j] = L.z[k];
-      rs.ax[j] = L.ax[k], rs.ay[j] = L.ay[k], rs.az[j] = L.az[k];
-      rs.ux[j] = L.ux[k], rs.uy[j] = L.uy[k], rs.uz[j] = L.uz[k];
-      rs.h[j] = L.h[k];
-      --L.left[k];
+      rs.copyLane(L, rs.lane[j], j);
+      --L.left[rs.lane[j]];
     }
     Lanes R = rs.view(r);
     if (freeFlying) {
@@ -204,21 +195,12 @@ void MotionKernel::defer(const block::Lanes& L, std::int64_t i0, const std::int3
                          bool freeFlying, block::BlockStencils& s, const block::Context& bc,
                          MotionStatistics& st) const {
   std::int32_t lanes[kBlock];
-  int r = 0;
-  for (int k = 0; k < L.count; ++k) {  // without branches, as in advanceLanes
-    lanes[r] = k;
-    r += L.left[k] > 0;
-  }
+  const int r = lanesWithSubstepsLeft(L, lanes);
   for (int q = 0; q < r; ++q) {
     const int k = lanes[q];
     if (d.count == kBlock) finishDeferred(d, freeFlying, s, bc, st);
     const int j = d.count++;
-    LaneStorage& ds = d.s;
-    ds.x[j] = L.x[k], ds.y[j] = L.y[k], ds.z[j] = L.z[k];
-    ds.ax[j] = L.ax[k], ds.ay[j] = L.ay[k], ds.az[j] = L.az[k];
-    ds.ux[j] = L.ux[k], ds.uy[j] = L.uy[k], ds.uz[j] = L.uz[k];
-    ds.h[j] = L.h[k];
-    ds.left[j] = L.left[k];
+    d.s.copyLane(L, k, j);
     d.tracer[j] = i0 + (laneOf ? laneOf[k] : k);
   }
 }
