@@ -58,6 +58,7 @@ struct Timing {
   double scalarFraction = 0.0;     ///< tracers that took the kernel's scalar path (last step)
   double wallTestFraction = 0.0;   ///< block-path tracers that needed the exact wall test (last step)
   double freeFlightFraction = 0.0; ///< tracers in free flight (last step)
+  nlohmann::json stageMsPerStep = nlohmann::json::object();  ///< TracerSimulation::stageSeconds() per step [ms]
 };
 
 template <class AfterRun = void (*)(TracerSimulation&)>
@@ -78,6 +79,7 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
     }
   }
   for (int k = 0; k < std::max(1, warmup); ++k) sim.step();
+  sim.resetStageSeconds();
   const double cpu0 = processCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < steps; ++k) sim.step();
@@ -91,6 +93,7 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
   t.scalarFraction = double(sim.motionStatistics().scalarPath) / double(scene.rcfd.tracers);
   t.wallTestFraction = double(sim.motionStatistics().exactWallTests) / double(scene.rcfd.tracers);
   t.freeFlightFraction = double(sim.motionStatistics().freeFlight) / double(scene.rcfd.tracers);
+  for (const auto& [stage, seconds] : sim.stageSeconds()) t.stageMsPerStep[stage] = seconds / steps * 1e3;
   after(sim);
   return t;
 }

@@ -37,6 +37,9 @@ nlohmann::json runTracers(const Options& options) {
             << headline.substepFraction << " extra sub-steps and " << headline.wallHitFraction
             << " reflections per tracer-step, " << headline.scalarFraction << " on the scalar path, "
             << headline.wallTestFraction << " exact wall tests)\n";
+  std::cerr << "  stages, ms per step:";
+  for (const auto& [stage, ms] : headline.stageMsPerStep.items()) std::cerr << " " << stage << " " << ms.get<double>();
+  std::cerr << "\n";
 
   nlohmann::json costs = nlohmann::json::object();
   const std::vector<std::pair<std::string, std::vector<std::string>>> variants = {
@@ -59,7 +62,8 @@ nlohmann::json runTracers(const Options& options) {
     costs[label] = {{"ms_per_step", t.secondsPerStep * 1e3},
                     {"cpu_ms_per_step", t.cpuSecondsPerStep * 1e3},
                     {"tracer_steps_per_s", t.tracerStepsPerSecond},
-                    {"free_flight_fraction", t.freeFlightFraction}};
+                    {"free_flight_fraction", t.freeFlightFraction},
+                    {"stage_ms_per_step", t.stageMsPerStep}};
     std::cerr << label << ": " << t.secondsPerStep * 1e3 << " ms/step, " << t.cpuSecondsPerStep * 1e3
               << " CPU-ms/step";
     if (t.freeFlightFraction > 0.0) std::cerr << " (" << t.freeFlightFraction << " of the tracers in free flight)";
@@ -75,6 +79,7 @@ nlohmann::json runTracers(const Options& options) {
           {"exact_wall_test_fraction", headline.wallTestFraction},
           {"substep_fraction", headline.substepFraction},
           {"cells", bench.cells},
+          {"stage_ms_per_step", headline.stageMsPerStep},
           {"effect_costs", costs}};
 }
 

@@ -10,6 +10,7 @@
 #include "tracers/CounterRng.hpp"
 #include "tracers/FluctuationModel.hpp"
 #include "tracers/BlockLanes.hpp"
+#include "tracers/CellIndex.hpp"
 #include "tracers/SingleSphereDrag.hpp"
 #include "tracers/UnitVectors.hpp"
 
@@ -267,6 +268,8 @@ void MotionKernel::move(TracerContext& ctx) {
   bc.cloudX = px, bc.cloudY = py, bc.cloudZ = pz, bc.cloudVx = pvx, bc.cloudVy = pvy, bc.cloudVz = pvz;
   bc.keepVelocity = settings_.freeFlight;
   constexpr std::int64_t kChunk = 16;  // blocks
+  std::int32_t* const nextCells = ctx.nextTracerCell.size() == cloud.size() ? ctx.nextTracerCell.data() : nullptr;
+  const CellIndexer indexer(grid_);
   const std::int64_t chunks = (blocks + kChunk - 1) / kChunk;
 #pragma omp parallel for schedule(dynamic, 1) if (n > kParallelThreshold) \
     reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests)
@@ -377,9 +380,14 @@ void MotionKernel::move(TracerContext& ctx) {
     }
     finishDeferred(deferred, false, stencils, bc, st);
     finishDeferred(deferredFree, true, stencils, bc, st);
+    if (nextCells) {  // the chunk's new positions are still in cache: their cells, for the next step
+      const std::int64_t first = chunk * kChunk * kBlock, last = std::min(n, (chunk + 1) * kChunk * kBlock);
+      indexer.cellsOf(int(last - first), px + first, py + first, pz + first, nextCells + first);
+    }
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
     scalarPath += st.scalarPath, exactWallTests += st.exactWallTests;
   }
+  if (nextCells) ctx.nextTracerCellStep = ctx.step + 1;
   stats_.substeps = substeps;
   stats_.wallHits = wallHits;
   stats_.freeFlight = freeFlight;

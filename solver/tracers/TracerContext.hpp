@@ -47,6 +47,12 @@ struct TracerContext {
   std::vector<std::int32_t> tracerCell;   ///< cell of every tracer at the start of the step
   std::vector<std::int32_t> tracerCount;  ///< tracers per cell at the start of the step
   std::vector<float> tracerAlpha;         ///< alpha_P of the tracers per cell [-]
+  /// The cells of the positions the motion kernel wrote, for the next step's tracerCell (the kernel
+  /// finds them while the positions are in cache; re-reading every position costs more). Valid only
+  /// when nextTracerCellStep == step; anything else that moves tracers must set it to -1
+  /// (TracerSimulation::context() does, for whoever takes the context to change the cloud).
+  std::vector<std::int32_t> nextTracerCell;
+  std::int64_t nextTracerCellStep = -1;
 
   // Provided by `spray` (null otherwise); `deposition` adds per-cell and per-tracer arrays to it.
   std::shared_ptr<SprayState> spray;

@@ -1,6 +1,7 @@
 #include "tracers/TracerSimulation.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -132,12 +133,45 @@ void TracerSimulation::placeTracers() {
 }
 
 void TracerSimulation::step() {
+  // A clock read per stage (tens of ns against milliseconds per step): the stage costs in one run.
+  using Clock = std::chrono::steady_clock;
   auto& ctx = *context_;
-  for (auto& e : effects_) e->beforeMove(ctx);
+  effectSeconds_.resize(effects_.size(), 0.0);
+  auto since = [](Clock::time_point& t) {
+    const Clock::time_point now = Clock::now();
+    const double s = std::chrono::duration<double>(now - t).count();
+    t = now;
+    return s;
+  };
+  Clock::time_point t = Clock::now();
+  for (std::size_t i = 0; i < effects_.size(); ++i) {
+    effects_[i]->beforeMove(ctx);
+    effectSeconds_[i] += since(t);
+  }
   kernel_->move(ctx);
-  for (auto& e : effects_) e->afterMove(ctx);
+  motionSeconds_ += since(t);
+  for (std::size_t i = 0; i < effects_.size(); ++i) {
+    effects_[i]->afterMove(ctx);
+    effectSeconds_[i] += since(t);
+  }
   ++ctx.step;
   loadFrames();
+  frameSeconds_ += since(t);
+}
+
+std::vector<std::pair<std::string, double>> TracerSimulation::stageSeconds() const {
+  std::vector<std::pair<std::string, double>> stages;
+  for (std::size_t i = 0; i < effectNames_.size(); ++i) {
+    stages.emplace_back(effectNames_[i], i < effectSeconds_.size() ? effectSeconds_[i] : 0.0);
+  }
+  stages.emplace_back("motion", motionSeconds_);
+  stages.emplace_back("frames", frameSeconds_);
+  return stages;
+}
+
+void TracerSimulation::resetStageSeconds() {
+  effectSeconds_.assign(effects_.size(), 0.0);
+  motionSeconds_ = frameSeconds_ = 0.0;
 }
 
 const TracerEffect* TracerSimulation::effect(const std::string& name) const {
@@ -191,6 +225,7 @@ void TracerSimulation::loadCheckpoint(const std::string& path) {
   cloud_.vy = f.readDoubles("/cloud/vy");
   cloud_.vz = f.readDoubles("/cloud/vz");
   context_->step = f.readInt64s("/state/step").at(0);
+  context_->nextTracerCellStep = -1;  // the positions came from the file
   for (std::size_t i = 0; i < effects_.size(); ++i) {
     effects_[i]->loadState(f, "/effects/" + effectNames_[i]);
   }

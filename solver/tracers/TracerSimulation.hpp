@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "recurrence/RecurrencePath.hpp"
@@ -40,7 +41,13 @@ class TracerSimulation {
   const TracerRunSettings& settings() const { return settings_; }
 
   const TracerCloud& cloud() const { return cloud_; }
-  TracerContext& context() { return *context_; }
+  /// Mutable access (tests and benchmarks move tracers with it): forgets the motion kernel's tracer
+  /// cells, which tracer_volume_fraction then recomputes from the positions.
+  TracerContext& context() {
+    context_->nextTracerCellStep = -1;
+    return *context_;
+  }
+  const TracerContext& context() const { return *context_; }
   const MotionStatistics& motionStatistics() const { return kernel_->statistics(); }
   /// Names of the effects that were built, in execution order.
   const std::vector<std::string>& effectNames() const { return effectNames_; }
@@ -54,6 +61,12 @@ class TracerSimulation {
   void writeResults(h5::File& out, nlohmann::json& summary) const;
   /// Writes every effect's SVG figures into outDir; returns the file names.
   std::vector<std::string> writeFigures(const std::string& outDir) const;
+
+  /// Wall seconds spent in each stage since construction (or resetStageSeconds()): every built
+  /// effect's beforeMove + afterMove under its name, "motion" for the kernel's move, "frames" for
+  /// loading the next step's frames. What each effect costs, measured inside one run (the benchmark).
+  std::vector<std::pair<std::string, double>> stageSeconds() const;
+  void resetStageSeconds();
 
   /// Frame used at `step` and, when dt < dt_rec, the blending partner and weight.
   void frameAt(std::int64_t step, int& frame, int& next, double& blend) const;
@@ -73,6 +86,8 @@ class TracerSimulation {
   std::vector<std::unique_ptr<TracerEffect>> effects_;
   std::unique_ptr<MotionKernel> kernel_;
   int stepsPerFrame_ = 1;
+  std::vector<double> effectSeconds_;  ///< per effect, in effects_' order
+  double motionSeconds_ = 0.0, frameSeconds_ = 0.0;
 };
 
 }  // namespace rcfd

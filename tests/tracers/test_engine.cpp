@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Errors.hpp"
+#include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 #include "TracerTestSupport.hpp"
 
@@ -143,6 +144,33 @@ TEST(Determinism, ResumedRunEqualsUninterruptedRun) {
   EXPECT_TRUE(bitIdentical(straight.cloud.x, resumed.cloud.x));
   EXPECT_TRUE(bitIdentical(straight.cloud.z, resumed.cloud.z));
   EXPECT_EQ(straight.summary.dump(), resumed.summary.dump());
+}
+
+TEST(Determinism, KernelsTracerCellsEqualRecomputedOnes) {
+  // The motion kernel hands the cells of the positions it wrote to the next step's
+  // tracer_volume_fraction; a run that makes it recompute them every step must be the same bit for bit.
+  const Scene s = fullTracerScene();
+  auto db = swirlingDatabase(s, 12);
+  const std::int64_t steps = 30;
+  const RecurrencePath path = sequentialPath(db->frameCount(), steps + 2);
+  TracerSimulation handedOver(s, db, path, {42, steps, 10});
+  TracerSimulation recomputed(s, db, path, {42, steps, 10});
+  for (std::int64_t k = 0; k < steps; ++k) {
+    handedOver.step();
+    const TracerSimulation& view = handedOver;  // const access keeps the kernel's cells
+    const TracerContext& ctx = view.context();
+    ASSERT_EQ(ctx.nextTracerCellStep, ctx.step);
+    std::vector<std::int32_t> cells(view.cloud().size());
+    CellIndexer(ctx.grid).cellsOf(int(cells.size()), view.cloud().x.data(), view.cloud().y.data(),
+                                  view.cloud().z.data(), cells.data());
+    ASSERT_EQ(cells, ctx.nextTracerCell) << "step " << k;
+    recomputed.context();  // mutable access: the cells are forgotten and recomputed
+    ASSERT_EQ(recomputed.context().nextTracerCellStep, -1);
+    recomputed.step();
+  }
+  EXPECT_TRUE(bitIdentical(handedOver.cloud().x, recomputed.cloud().x));
+  EXPECT_TRUE(bitIdentical(handedOver.cloud().y, recomputed.cloud().y));
+  EXPECT_TRUE(bitIdentical(handedOver.cloud().z, recomputed.cloud().z));
 }
 
 TEST(Robustness, AMillionStepsThroughRandomFieldsLoseNothing) {

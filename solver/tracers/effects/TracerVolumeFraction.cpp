@@ -1,4 +1,5 @@
-// tracer_volume_fraction: maps the tracers to the grid at the start of every step. alpha_P of a cell is
+// tracer_volume_fraction: maps the tracers to the grid at the start of every step (from the cells the
+// motion kernel found for the positions it wrote, when it did). alpha_P of a cell is
 // (tracers in the cell) x (particle volume per tracer) / (open volume of the cell). Counting is integer
 // and therefore the same for any thread count. Each thread counts its share of the tracers into its own
 // histogram (no atomics: a locked increment per tracer cost more than the rest of this pass), and the
@@ -7,6 +8,7 @@
 #include <memory>
 #include <omp.h>
 
+#include "tracers/CellIndex.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
@@ -16,9 +18,10 @@ class TracerVolumeFractionEffect final : public TracerEffect {
  public:
   explicit TracerVolumeFractionEffect(TracerContext& ctx) {
     ctx.tracerCell.assign(ctx.cloud.size(), 0);
+    ctx.nextTracerCell.assign(ctx.cloud.size(), 0);
     ctx.tracerCount.assign(std::size_t(ctx.grid.cellCount()), 0);
     ctx.tracerAlpha.assign(std::size_t(ctx.grid.cellCount()), 0.0f);
-    bytes_ = ctx.tracerCell.size() * sizeof(std::int32_t) + ctx.tracerCount.size() * sizeof(std::int32_t) +
+    bytes_ = 2 * ctx.tracerCell.size() * sizeof(std::int32_t) + ctx.tracerCount.size() * sizeof(std::int32_t) +
              ctx.tracerAlpha.size() * sizeof(float);
   }
   std::size_t allocatedBytes() const override {
@@ -42,6 +45,9 @@ class TracerVolumeFractionEffect final : public TracerEffect {
         alphaPerTracer_[std::size_t(c)] = open > 0.0 ? volumePerTracer / open : 0.0;
       }
     }
+    const bool reuse = ctx.nextTracerCellStep == ctx.step;
+    if (reuse) ctx.tracerCell.swap(ctx.nextTracerCell);
+    ctx.nextTracerCellStep = -1;
     // One parallel region (each is a fork and a join): cells and counts of the tracers, block by block;
     // then, after a barrier, the threads' histograms summed and alpha_P, cell by cell.
 #pragma omp parallel if (parallel) num_threads(threads)
@@ -50,38 +56,20 @@ class TracerVolumeFractionEffect final : public TracerEffect {
       const int others = omp_get_num_threads() - 1;  // a team may be smaller than asked for
       std::int32_t* histogram = t == 0 ? count.data() : partial_.data() + std::size_t(t - 1) * std::size_t(cells);
       std::fill(histogram, histogram + cells, 0);
-      // The cell of every tracer, on plain locals, which vectorises.
+      // The cells of the tracers: the motion kernel's, found for the positions it has just written, or
+      // (the first step, after a checkpoint, after positions were set from outside) computed here.
+      const CellIndexer indexer(ctx.grid);
       const double* x = cloud.x.data();
       const double* y = cloud.y.data();
       const double* z = cloud.z.data();
       std::int32_t* cellOut = ctx.tracerCell.data();
-      const double ox = ctx.grid.origin.x(), oy = ctx.grid.origin.y(), oz = ctx.grid.origin.z();
-      // Multiplications by the inverse spacing, not CartesianGrid's divisions (a vector division costs
-      // as much as the rest of the loop): a point within an ulp of a cell face may land in the
-      // neighbour, which no user of the cells can tell (the motion kernel's wall bound allows for it).
-      const double ihx = 1.0 / ctx.grid.spacing.x(), ihy = 1.0 / ctx.grid.spacing.y(), ihz = 1.0 / ctx.grid.spacing.z();
-      const int nx = ctx.grid.shape[0], ny = ctx.grid.shape[1], nz = ctx.grid.shape[2];
-      constexpr std::int64_t kBlock = 256;  // blocks of plain int loops: what GCC's vectoriser takes
+      constexpr std::int64_t kBlock = 256;
 #pragma omp for schedule(static)
       for (std::int64_t b = 0; b < (n + kBlock - 1) / kBlock; ++b) {
         const std::int64_t i0 = b * kBlock;
         const int count = int(std::min(kBlock, n - i0));
-        const double* bx = x + i0;
-        const double* by = y + i0;
-        const double* bz = z + i0;
         std::int32_t* out = cellOut + i0;
-#pragma omp simd
-        for (int k = 0; k < count; ++k) {
-          // int(floor(t)) as truncation corrected for negative t (the same integer; floor itself does
-          // not vectorise under GCC's default trapping-math).
-          const double tx = (bx[k] - ox) * ihx, ty = (by[k] - oy) * ihy, tz = (bz[k] - oz) * ihz;
-          int ci = int(tx), cj = int(ty), ck = int(tz);
-          ci -= double(ci) > tx, cj -= double(cj) > ty, ck -= double(ck) > tz;
-          ci = ci < 0 ? 0 : (ci >= nx ? nx - 1 : ci);
-          cj = cj < 0 ? 0 : (cj >= ny ? ny - 1 : cj);
-          ck = ck < 0 ? 0 : (ck >= nz ? nz - 1 : ck);
-          out[k] = (ck * ny + cj) * nx + ci;
-        }
+        if (!reuse) indexer.cellsOf(count, x + i0, y + i0, z + i0, out);
         for (int k = 0; k < count; ++k) ++histogram[out[k]];
       }
       // (the implicit barrier of the loop above: every histogram is complete)
