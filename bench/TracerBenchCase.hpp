@@ -9,7 +9,6 @@
 #include <ctime>
 #include <iostream>
 #include <memory>
-#include <random>
 
 #include "BenchRegistry.hpp"
 #include "SyntheticFields.hpp"
@@ -69,15 +68,10 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
   // RCFD_BENCH_SCALAR_KERNEL=1: every tracer through the kernel's scalar path (what the block path saves).
   const char* scalarOnly = std::getenv("RCFD_BENCH_SCALAR_KERNEL");
   const bool vectorised = !(scalarOnly && std::string(scalarOnly) == "1");
-  TracerSimulation sim(scene, db, path, {1, warmup + steps, 0, vectorised});
-  if (const char* e = std::getenv("RCFD_BENCH_SHUFFLE"); e && std::string(e) == "1") {
-    TracerCloud& cloud = sim.context().cloud;
-    std::mt19937_64 gen(7);
-    for (std::size_t i = cloud.size(); i > 1; --i) {
-      const std::size_t j = std::uniform_int_distribution<std::size_t>(0, i - 1)(gen);
-      std::swap(cloud.x[i - 1], cloud.x[j]), std::swap(cloud.y[i - 1], cloud.y[j]), std::swap(cloud.z[i - 1], cloud.z[j]);
-    }
-  }
+  // RCFD_BENCH_SORT_INTERVAL=N: tracers re-sorted by cell every N steps (0: never; default 100).
+  TracerRunSettings settings{1, warmup + steps, 0, vectorised};
+  if (const char* e = std::getenv("RCFD_BENCH_SORT_INTERVAL")) settings.sortInterval = std::atoll(e);
+  TracerSimulation sim(scene, db, path, settings);
   for (int k = 0; k < std::max(1, warmup); ++k) sim.step();
   sim.resetStageSeconds();
   const double cpu0 = processCpuSeconds();

@@ -64,6 +64,13 @@ class ZoneStays {
     return finished;
   }
 
+  /// The members were reordered: member j is the one that was member from[j].
+  void permute(const std::vector<std::int32_t>& from) {
+    std::vector<std::int64_t> e(entry_.size());
+    for (std::size_t j = 0; j < e.size(); ++j) e[j] = entry_[std::size_t(from[j])];
+    entry_.swap(e);
+  }
+
   /// Adds completed stays (durations in samples) to the histogram of durations.
   void addDurations(const std::vector<std::int64_t>& durations);
 

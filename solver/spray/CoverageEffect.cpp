@@ -41,8 +41,8 @@ class CoverageEffect final : public TracerEffect {
     double collected = 0.0;
     for (double d : state_->tracerDroplets) collected += d;
     const double realParticles = ctx.cloud.particlesPerTracer * double(droplets.size());
-    out.write("/coverage/per_tracer", phi);
-    out.write("/coverage/droplets_per_particle", droplets);
+    out.write("/coverage/per_tracer", ctx.cloud.inIdOrder(phi));
+    out.write("/coverage/droplets_per_particle", ctx.cloud.inIdOrder(droplets));
     const Distribution d = describe(phi, bins_, 0.0, 1.0);
     out.write("/coverage/histogram_edges", d.edges);
     std::vector<std::int64_t> counts(d.counts.begin(), d.counts.end());

@@ -53,6 +53,13 @@ class DepositionEffect final : public TracerEffect {
     handOut(ctx);
   }
 
+  void permuteTracers(TracerContext&, const std::vector<std::int32_t>& from) override {
+    auto& d = state_->tracerDroplets;
+    std::vector<double> moved(d.size());
+    for (std::size_t j = 0; j < d.size(); ++j) moved[j] = d[std::size_t(from[j])];
+    d.swap(moved);
+  }
+
   void saveState(h5::File& f, const std::string& g) const override {
     f.write(g + "/tracer_droplets", state_->tracerDroplets);
     f.write(g + "/cell_pending", state_->cellPending);

@@ -260,6 +260,7 @@ void MotionKernel::move(TracerContext& ctx) {
   double* const pvy = cloud.vy.data();
   double* const pvz = cloud.vz.data();
   const float* cellData = cellData_.data();
+  const std::int32_t* const ids = cloud.id.data();
   const bool vectorised = settings_.vectorised;
   // Dynamic chunks of blocks: sub-stepped and near-wall tracers cluster (in the spout, at the walls), so
   // equal shares of blocks are not equal work. Lanes with sub-steps left after their first are
@@ -309,7 +310,7 @@ void MotionKernel::move(TracerContext& ctx) {
   #pragma omp simd
         for (int k = 0; k < count; ++k) {
           double nx, ny, nz;
-          counterUnitVector(rngPrefix, std::uint64_t(i0 + k), nx, ny, nz);
+          counterUnitVector(rngPrefix, std::uint64_t(ids[i0 + k]), nx, ny, nz);  // the tracer's own stream
           ax[k] = speed[k] * nx, ay[k] = speed[k] * ny, az[k] = speed[k] * nz;
         }
       } else {

@@ -2,7 +2,9 @@
 /// \file TracerCloud.hpp
 /// Lagrangian tracers as a structure of arrays. Each tracer stands for `particlesPerTracer` real
 /// particles of the bed. Positions and velocities are double: tracers are stepped 720,000 times in a
-/// 1 h run and the arrays (48 B per tracer) are small next to the field frames.
+/// 1 h run and the arrays (48 B per tracer) are small next to the field frames. The simulation keeps
+/// the tracers sorted by cell (TracerSimulation::sortTracers) for the memory locality of the field
+/// reads, so a tracer's index changes; `id` is its identity (random streams, per-tracer results).
 
 #include <cstdint>
 #include <vector>
@@ -19,6 +21,8 @@ class TracerCloud {
   void resize(std::size_t n) {
     x.assign(n, 0.0), y.assign(n, 0.0), z.assign(n, 0.0);
     vx.assign(n, 0.0), vy.assign(n, 0.0), vz.assign(n, 0.0);
+    id.resize(n);
+    for (std::size_t i = 0; i < n; ++i) id[i] = std::int32_t(i);
   }
   std::size_t size() const { return x.size(); }
 
@@ -29,6 +33,14 @@ class TracerCloud {
 
   std::vector<double> x, y, z;     ///< position [m]
   std::vector<double> vx, vy, vz;  ///< velocity of the last step [m/s]; kept only with free_flight, its one reader (0 otherwise)
+  std::vector<std::int32_t> id;    ///< identity of the tracer at each index (0 .. size-1, a permutation)
+  /// values[i] given per index, returned per id (per-tracer results are written in id order).
+  template <class T>
+  std::vector<T> inIdOrder(const std::vector<T>& values) const {
+    std::vector<T> out(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) out[std::size_t(id[i])] = values[i];
+    return out;
+  }
   double particlesPerTracer = 1.0; ///< real particles represented by one tracer [-]
   double particleVolume = 0.0;     ///< volume of one real particle [m3]
 };

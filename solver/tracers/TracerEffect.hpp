@@ -51,6 +51,9 @@ class TracerEffect {
   virtual std::vector<std::string> writeFigures(const TracerContext&, const std::string& outDir) const {
     return {};
   }
+  /// The tracers were reordered: index j now holds the tracer that was at index from[j]. An effect with
+  /// per-tracer state reorders it the same way.
+  virtual void permuteTracers(TracerContext&, const std::vector<std::int32_t>& from) {}
   /// Checkpoint state under `group` (bit-exact restore).
   virtual void saveState(h5::File&, const std::string& group) const {}
   virtual void loadState(const h5::File&, const std::string& group) {}

@@ -4,9 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 
 #include "core/Errors.hpp"
+#include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 
 namespace rcfd {
@@ -23,6 +25,9 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
                          std::to_string(dtRec) + " s of the database)");
   }
   if (scene_.rcfd.tracers < 1) throw InputError("scene", "/rcfd/tracers", "must be at least 1");
+  if (scene_.rcfd.tracers > std::numeric_limits<std::int32_t>::max()) {  // TracerCloud::id, tracer cells
+    throw InputError("scene", "/rcfd/tracers", "must be at most 2147483647");
+  }
   const std::int64_t framesNeeded = settings_.steps / stepsPerFrame_ + 2;
   if (std::int64_t(path_.frames.size()) < framesNeeded) {
     throw RunError("recurrence path has " + std::to_string(path_.frames.size()) + " frames; the run needs " +
@@ -144,6 +149,10 @@ void TracerSimulation::step() {
     return s;
   };
   Clock::time_point t = Clock::now();
+  if (settings_.sortInterval > 0 && ctx.step % settings_.sortInterval == 0) {
+    sortTracers();
+    sortSeconds_ += since(t);
+  }
   for (std::size_t i = 0; i < effects_.size(); ++i) {
     effects_[i]->beforeMove(ctx);
     effectSeconds_[i] += since(t);
@@ -166,12 +175,44 @@ std::vector<std::pair<std::string, double>> TracerSimulation::stageSeconds() con
   }
   stages.emplace_back("motion", motionSeconds_);
   stages.emplace_back("frames", frameSeconds_);
+  stages.emplace_back("sort", sortSeconds_);
   return stages;
 }
 
 void TracerSimulation::resetStageSeconds() {
   effectSeconds_.assign(effects_.size(), 0.0);
-  motionSeconds_ = frameSeconds_ = 0.0;
+  motionSeconds_ = frameSeconds_ = sortSeconds_ = 0.0;
+}
+
+void TracerSimulation::sortTracers() {
+  auto& ctx = *context_;
+  const std::size_t n = cloud_.size();
+  const std::size_t cells = std::size_t(ctx.grid.cellCount());
+  std::vector<std::int32_t> cell(n);
+  CellIndexer(ctx.grid).cellsOf(int(n), cloud_.x.data(), cloud_.y.data(), cloud_.z.data(), cell.data());
+  // Counting sort by cell, stable: the same order for any thread count and on resume.
+  std::vector<std::int64_t> start(cells + 1, 0);
+  for (const std::int32_t c : cell) ++start[std::size_t(c) + 1];
+  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+  std::vector<std::int32_t> from(n);
+  for (std::size_t i = 0; i < n; ++i) from[std::size_t(start[std::size_t(cell[i])]++)] = std::int32_t(i);
+  auto reorder = [&](auto& values) {
+    std::remove_reference_t<decltype(values)> moved(n);
+#pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
+    for (std::int64_t j = 0; j < std::int64_t(n); ++j) moved[std::size_t(j)] = values[std::size_t(from[std::size_t(j)])];
+    values.swap(moved);
+  };
+  reorder(cloud_.x), reorder(cloud_.y), reorder(cloud_.z);
+  reorder(cloud_.vx), reorder(cloud_.vy), reorder(cloud_.vz);
+  reorder(cloud_.id);
+  for (auto& e : effects_) e->permuteTracers(ctx, from);
+  if (ctx.nextTracerCell.size() == n) {  // the cells are known: tracer_volume_fraction takes them
+    reorder(cell);
+    ctx.nextTracerCell.swap(cell);
+    ctx.nextTracerCellStep = ctx.step;
+  } else {
+    ctx.nextTracerCellStep = -1;
+  }
 }
 
 const TracerEffect* TracerSimulation::effect(const std::string& name) const {
@@ -197,6 +238,7 @@ void TracerSimulation::saveCheckpoint(const std::string& path) const {
     f.write("/cloud/vx", cloud_.vx);
     f.write("/cloud/vy", cloud_.vy);
     f.write("/cloud/vz", cloud_.vz);
+    f.write("/cloud/id", std::vector<std::int64_t>(cloud_.id.begin(), cloud_.id.end()));
     f.write("/state/step", std::vector<std::int64_t>{context_->step});
     f.write("/state/seed", std::vector<std::int64_t>{std::int64_t(settings_.seed)});
     for (std::size_t i = 0; i < effects_.size(); ++i) {
@@ -224,6 +266,10 @@ void TracerSimulation::loadCheckpoint(const std::string& path) {
   cloud_.vx = f.readDoubles("/cloud/vx");
   cloud_.vy = f.readDoubles("/cloud/vy");
   cloud_.vz = f.readDoubles("/cloud/vz");
+  if (f.exists("/cloud/id")) {  // checkpoints from before sorting keep the identity order
+    const auto id = f.readInt64s("/cloud/id");
+    for (std::size_t i = 0; i < cloud_.size(); ++i) cloud_.id.at(i) = std::int32_t(id.at(i));
+  }
   context_->step = f.readInt64s("/state/step").at(0);
   context_->nextTracerCellStep = -1;  // the positions came from the file
   for (std::size_t i = 0; i < effects_.size(); ++i) {
@@ -233,9 +279,9 @@ void TracerSimulation::loadCheckpoint(const std::string& path) {
 }
 
 void TracerSimulation::writeResults(h5::File& out, nlohmann::json& summary) const {
-  out.write("/tracers/x", cloud_.x);
-  out.write("/tracers/y", cloud_.y);
-  out.write("/tracers/z", cloud_.z);
+  out.write("/tracers/x", cloud_.inIdOrder(cloud_.x));
+  out.write("/tracers/y", cloud_.inIdOrder(cloud_.y));
+  out.write("/tracers/z", cloud_.inIdOrder(cloud_.z));
   summary["tracers"] = cloud_.size();
   summary["particles_per_tracer"] = cloud_.particlesPerTracer;
   for (std::size_t i = 0; i < effects_.size(); ++i) effects_[i]->writeResults(*context_, out, summary);

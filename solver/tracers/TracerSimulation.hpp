@@ -23,6 +23,10 @@ struct TracerRunSettings {
   std::int64_t steps = 0;         ///< planned number of steps
   std::int64_t discardSteps = 0;  ///< statistics start at this step
   bool vectorisedKernel = true;   ///< false: the motion kernel's scalar path for every tracer (tests)
+  /// The tracers are sorted by cell at the steps that are multiples of this (0: never). Sorted tracers
+  /// read the step fields from cache (neighbours in memory share corners); the order decays as they
+  /// mix. A fixed interval keeps results a function of the scene and seed.
+  std::int64_t sortInterval = 100;
 };
 
 class TracerSimulation {
@@ -64,7 +68,7 @@ class TracerSimulation {
 
   /// Wall seconds spent in each stage since construction (or resetStageSeconds()): every built
   /// effect's beforeMove + afterMove under its name, "motion" for the kernel's move, "frames" for
-  /// loading the next step's frames. What each effect costs, measured inside one run (the benchmark).
+  /// loading the next step's frames, "sort" for sortTracers(). What each effect costs, measured inside one run (the benchmark).
   std::vector<std::pair<std::string, double>> stageSeconds() const;
   void resetStageSeconds();
 
@@ -73,6 +77,9 @@ class TracerSimulation {
 
  private:
   void placeTracers();
+  /// Reorders the tracers by cell (stable: by index within a cell), with every effect's per-tracer
+  /// state, and hands the cells to tracer_volume_fraction.
+  void sortTracers();
   void loadFrames();
 
   Scene scene_;
@@ -87,7 +94,7 @@ class TracerSimulation {
   std::unique_ptr<MotionKernel> kernel_;
   int stepsPerFrame_ = 1;
   std::vector<double> effectSeconds_;  ///< per effect, in effects_' order
-  double motionSeconds_ = 0.0, frameSeconds_ = 0.0;
+  double motionSeconds_ = 0.0, frameSeconds_ = 0.0, sortSeconds_ = 0.0;
 };
 
 }  // namespace rcfd

@@ -88,7 +88,10 @@ TEST(Fluctuation, RelaxesAnOverpackedHalfAndDoesNothingWithoutD0) {
     for (std::int64_t k = 1; k < steps; ++k) sim.step();
     const double last = rms();
     double moved = 0.0;
-    for (std::size_t i = 0; i < start.size(); ++i) moved += (sim.cloud().position(i) - start.position(i)).norm();
+    // The tracers are re-sorted by cell as they go: index i holds tracer id[i] (start is in id order).
+    for (std::size_t i = 0; i < start.size(); ++i) {
+      moved += (sim.cloud().position(i) - start.position(std::size_t(sim.cloud().id[i]))).norm();
+    }
     return std::make_tuple(moved, first, last);
   };
   const auto [movedWithout, firstWithout, lastWithout] = run(0.0);

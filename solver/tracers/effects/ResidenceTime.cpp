@@ -91,6 +91,8 @@ class ResidenceTimeEffect final : public TracerEffect {
                          {"series_file", "result.h5:/holdup/particles"}};
   }
 
+  void permuteTracers(TracerContext&, const std::vector<std::int32_t>& from) override { stays_.permute(from); }
+
   void saveState(h5::File& f, const std::string& g) const override {
     stays_.save(f, g);
     std::vector<std::int64_t> h(holdup_.begin(), holdup_.end());
