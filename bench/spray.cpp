@@ -64,7 +64,9 @@ nlohmann::json runSpray(const Options& options) {
           {"overspray_fraction_so_far", injected > 0.0 ? overspray / injected : 0.0},
           {"tracers", scene.rcfd.tracers},
           {"cells", bench.cells},
-          {"dt", dt}};
+          {"dt", dt},
+          {"tracer_stage_ms_per_step", tracers.stageMsPerStep},
+          {"stage_ms_per_step", spray.stageMsPerStep}};
 }
 
 const bool registered =

@@ -290,7 +290,7 @@ void MotionKernel::move(TracerContext& ctx) {
       if (haveTracerAlpha) {
         for (int k = 0; k < count; ++k) cellOf[k] = ctx.tracerCell[std::size_t(i0 + k)];
       } else {
-        for (int k = 0; k < count; ++k) cellOf[k] = std::int32_t(grid_.flatIndexOf(cloud.position(std::size_t(i0 + k))));
+        indexer.cellsOf(count, px + i0, py + i0, pz + i0, cellOf);
       }
       std::int64_t freeLanes = 0;
       if (settings_.freeFlight) {
