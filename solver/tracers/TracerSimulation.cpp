@@ -69,6 +69,7 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
     effectNames_.push_back(name);
   }
   kernel_ = std::make_unique<MotionKernel>(ctx, motion);
+  keepsVelocities_ = motion.freeFlight;  // otherwise the velocities stay 0 and need no reordering
 }
 
 TracerSimulation::~TracerSimulation() = default;
@@ -188,27 +189,29 @@ void TracerSimulation::sortTracers() {
   auto& ctx = *context_;
   const std::size_t n = cloud_.size();
   const std::size_t cells = std::size_t(ctx.grid.cellCount());
-  std::vector<std::int32_t> cell(n);
-  CellIndexer(ctx.grid).cellsOf(int(n), cloud_.x.data(), cloud_.y.data(), cloud_.z.data(), cell.data());
+  // Scratch kept between sorts (fresh arrays would cost their page faults every time) and swapped
+  // with the arrays they replace.
+  auto& s = sortScratch_;
+  s.cell.resize(n), s.from.resize(n), s.ints.resize(n), s.doubles.resize(n);
+  s.start.assign(cells + 1, 0);
+  CellIndexer(ctx.grid).cellsOf(int(n), cloud_.x.data(), cloud_.y.data(), cloud_.z.data(), s.cell.data());
   // Counting sort by cell, stable: the same order for any thread count and on resume.
-  std::vector<std::int64_t> start(cells + 1, 0);
-  for (const std::int32_t c : cell) ++start[std::size_t(c) + 1];
-  for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
-  std::vector<std::int32_t> from(n);
-  for (std::size_t i = 0; i < n; ++i) from[std::size_t(start[std::size_t(cell[i])]++)] = std::int32_t(i);
-  auto reorder = [&](auto& values) {
-    std::remove_reference_t<decltype(values)> moved(n);
+  for (const std::int32_t c : s.cell) ++s.start[std::size_t(c) + 1];
+  for (std::size_t c = 0; c < cells; ++c) s.start[c + 1] += s.start[c];
+  for (std::size_t i = 0; i < n; ++i) s.from[std::size_t(s.start[std::size_t(s.cell[i])]++)] = std::int32_t(i);
+  const std::int32_t* from = s.from.data();
+  auto reorder = [&](auto& values, auto& scratch) {
 #pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
-    for (std::int64_t j = 0; j < std::int64_t(n); ++j) moved[std::size_t(j)] = values[std::size_t(from[std::size_t(j)])];
-    values.swap(moved);
+    for (std::int64_t j = 0; j < std::int64_t(n); ++j) scratch[std::size_t(j)] = values[std::size_t(from[j])];
+    values.swap(scratch);
   };
-  reorder(cloud_.x), reorder(cloud_.y), reorder(cloud_.z);
-  reorder(cloud_.vx), reorder(cloud_.vy), reorder(cloud_.vz);
-  reorder(cloud_.id);
-  for (auto& e : effects_) e->permuteTracers(ctx, from);
+  reorder(cloud_.x, s.doubles), reorder(cloud_.y, s.doubles), reorder(cloud_.z, s.doubles);
+  if (keepsVelocities_) reorder(cloud_.vx, s.doubles), reorder(cloud_.vy, s.doubles), reorder(cloud_.vz, s.doubles);
+  reorder(cloud_.id, s.ints);
+  for (auto& e : effects_) e->permuteTracers(ctx, s.from);
   if (ctx.nextTracerCell.size() == n) {  // the cells are known: tracer_volume_fraction takes them
-    reorder(cell);
-    ctx.nextTracerCell.swap(cell);
+    reorder(s.cell, s.ints);
+    ctx.nextTracerCell.swap(s.cell);
     ctx.nextTracerCellStep = ctx.step;
   } else {
     ctx.nextTracerCellStep = -1;

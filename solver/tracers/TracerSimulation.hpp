@@ -95,6 +95,12 @@ class TracerSimulation {
   int stepsPerFrame_ = 1;
   std::vector<double> effectSeconds_;  ///< per effect, in effects_' order
   double motionSeconds_ = 0.0, frameSeconds_ = 0.0, sortSeconds_ = 0.0;
+  bool keepsVelocities_ = false;  ///< free_flight: the cloud's velocities are state
+  struct SortScratch {
+    std::vector<std::int32_t> cell, from, ints;
+    std::vector<std::int64_t> start;
+    std::vector<double> doubles;
+  } sortScratch_;
 };
 
 }  // namespace rcfd
