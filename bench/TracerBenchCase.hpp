@@ -52,11 +52,11 @@ struct Timing {
   double secondsPerStep = 0.0;
   double tracerStepsPerSecond = 0.0;
   double cpuSecondsPerStep = 0.0;  ///< process CPU time (all threads) per step: what the load distorts least
-  double substepFraction = 0.0;    ///< extra sub-steps per tracer-step (last step)
-  double wallHitFraction = 0.0;    ///< reflections per tracer-step (last step)
-  double scalarFraction = 0.0;     ///< tracers that took the kernel's scalar path (last step)
-  double wallTestFraction = 0.0;   ///< block-path tracers that needed the exact wall test (last step)
-  double freeFlightFraction = 0.0; ///< tracers in free flight (last step)
+  double substepFraction = 0.0;    ///< extra sub-steps per tracer-step (mean over the timed steps)
+  double wallHitFraction = 0.0;    ///< reflections per tracer-step (mean)
+  double scalarFraction = 0.0;     ///< tracer-steps on the kernel's scalar path (mean)
+  double wallTestFraction = 0.0;   ///< block-path sub-steps that needed the exact wall test, per tracer-step (mean)
+  double freeFlightFraction = 0.0; ///< tracer-steps in free flight (mean)
   nlohmann::json stageMsPerStep = nlohmann::json::object();  ///< TracerSimulation::stageSeconds() per step [ms]
 };
 
@@ -76,17 +76,24 @@ Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup
   sim.resetStageSeconds();
   const double cpu0 = processCpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < steps; ++k) sim.step();
+  MotionStatistics sum;  // over the timed steps (the field's phases differ in how much sub-stepping they need)
+  for (int k = 0; k < steps; ++k) {
+    sim.step();
+    const MotionStatistics& m = sim.motionStatistics();
+    sum.substeps += m.substeps, sum.wallHits += m.wallHits, sum.scalarPath += m.scalarPath;
+    sum.exactWallTests += m.exactWallTests, sum.freeFlight += m.freeFlight;
+  }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Timing t;
   t.secondsPerStep = s / steps;
   t.cpuSecondsPerStep = (processCpuSeconds() - cpu0) / steps;
   t.tracerStepsPerSecond = double(scene.rcfd.tracers) / t.secondsPerStep;
-  t.substepFraction = double(sim.motionStatistics().substeps) / double(scene.rcfd.tracers);
-  t.wallHitFraction = double(sim.motionStatistics().wallHits) / double(scene.rcfd.tracers);
-  t.scalarFraction = double(sim.motionStatistics().scalarPath) / double(scene.rcfd.tracers);
-  t.wallTestFraction = double(sim.motionStatistics().exactWallTests) / double(scene.rcfd.tracers);
-  t.freeFlightFraction = double(sim.motionStatistics().freeFlight) / double(scene.rcfd.tracers);
+  const double tracerSteps = double(scene.rcfd.tracers) * double(steps);
+  t.substepFraction = double(sum.substeps) / tracerSteps;
+  t.wallHitFraction = double(sum.wallHits) / tracerSteps;
+  t.scalarFraction = double(sum.scalarPath) / tracerSteps;
+  t.wallTestFraction = double(sum.exactWallTests) / tracerSteps;
+  t.freeFlightFraction = double(sum.freeFlight) / tracerSteps;
   for (const auto& [stage, seconds] : sim.stageSeconds()) t.stageMsPerStep[stage] = seconds / steps * 1e3;
   after(sim);
   return t;
