@@ -10,6 +10,7 @@
 #include "geometry/WallClearance.hpp"
 #include "spray/SprayState.hpp"
 #include "tracers/CounterRng.hpp"
+#include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
@@ -33,7 +34,9 @@ class SprayEffect final : public TracerEffect {
                                    0.5 * ctx.grid.spacing.norm() + 2.0 * ctx.apparatus.boundaryTolerance());
   }
 
-  std::size_t allocatedBytes() const override { return sizeof(SprayState) + clearance_.capacity() * sizeof(float); }
+  std::size_t allocatedBytes() const override {
+    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + gasField_.bytes();
+  }
 
   void afterMove(TracerContext& ctx) override {
     auto& s = *ctx.spray;
@@ -127,21 +130,27 @@ class SprayEffect final : public TracerEffect {
     s.balance.injected = double(s.injectedParcels) * s.dropletsPerParcel;
   }
 
-  void moveParcels(TracerContext& ctx, SprayState& s) const {
+  void moveParcels(TracerContext& ctx, SprayState& s) {
     auto& pc = s.parcels;
     const std::int64_t n = std::int64_t(pc.size());
     std::vector<std::int8_t> exit(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
-    const FrameSampler sampler = ctx.sampler();
+    if (n == 0) return;
+    const FrameSampler frames = ctx.sampler();
+    // u_G^rec of the step as a 4-float step field, blended once per cell: a parcel sub-step then reads
+    // its corners like a tracer (float trilinear, block::interpolateCorners) instead of blending and
+    // converting 8 corners in double.
+    gasField_.build(frames, true, ctx.grid.cellCount() > kParallelThreshold);
+    const StepFieldSampler sampler(gasField_, frames.locator());
     const double dt = ctx.dt;
 #pragma omp parallel for schedule(dynamic, 64) if (n > kParallelThreshold)  // sub-steps vary: dynamic
     for (std::int64_t j = 0; j < n; ++j) {
       Eigen::Vector3d p = pc.position(std::size_t(j));
-      Eigen::Vector3d u = sampler.velocity(p, true);
+      Eigen::Vector3d u = sampler.sample(p);
       const double courant = u.norm() * dt / minSpacing_;
       const int nsub = courant < 64.0 ? std::max(1, int(std::ceil(courant))) : 64;
       const double h = dt / nsub;
       for (int k = 0; k < nsub; ++k) {
-        if (k > 0) u = sampler.velocity(p, true);
+        if (k > 0) u = sampler.sample(p);
         const Eigen::Vector3d end = p + h * u;
         if (h * u.norm() < double(clearance_[std::size_t(ctx.grid.flatIndexOf(p))])) {
           p = end;
@@ -177,6 +186,7 @@ class SprayEffect final : public TracerEffect {
   double launchSpread_ = 0.0;
   double minSpacing_ = 1.0;
   std::vector<float> clearance_;  ///< per cell: moves shorter than this hit no boundary [m]
+  StepVelocityField gasField_;    ///< u_G^rec of the step (rebuilt every step with parcels airborne)
 };
 
 const bool registered = TracerEffectRegistry::add(

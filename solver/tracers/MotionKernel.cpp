@@ -130,27 +130,6 @@ void MotionKernel::prepare(const TracerContext& ctx, const FrameSampler& sampler
   }
 }
 
-namespace {
-/// u at a point of a step field: the block path's arithmetic (block::interpolateCorners) for one point.
-class PointSampler {
- public:
-  PointSampler(const StepVelocityField& field, const TrilinearLocator& locator) : field_(field), locator_(locator) {
-    corners_.set(locator.offsets32());
-  }
-  Eigen::Vector3d sample(const Eigen::Vector3d& p) const {
-    const TrilinearStencil s = locator_.locate(p);
-    float u[3];
-    block::interpolateCorners(field_.floats() + 4 * s.base, corners_.off4, float(s.f[0]), float(s.f[1]),
-                              float(s.f[2]), u);
-    return {double(u[0]), double(u[1]), double(u[2])};
-  }
-
- private:
-  const StepVelocityField& field_;
-  const TrilinearLocator& locator_;
-  block::CornerOffsets corners_;
-};
-}  // namespace
 
 void MotionKernel::move(TracerContext& ctx) {
   using namespace block;
@@ -220,7 +199,7 @@ void MotionKernel::move(TracerContext& ctx) {
     if (settings_.freeFlight && sampler.alphaP(cell) < settings_.freeFlightAlpha) {
       // Free flight: implicit drag relaxation toward u_G^rec plus gravity, stable for any dt / tau.
       ++st.freeFlight;
-      const PointSampler gas(gasVelocity_, locator);
+      const StepFieldSampler gas(gasVelocity_, locator);
       const int nsub = substepsFor(v.norm() * dt, st.substepCapped);
       const double h = dt / nsub;
       for (int s = 0; s < nsub; ++s) {
@@ -234,7 +213,7 @@ void MotionKernel::move(TracerContext& ctx) {
       }
       st.substeps += nsub - 1;
     } else {
-      const PointSampler up(particleVelocity_, locator);
+      const StepFieldSampler up(particleVelocity_, locator);
       Eigen::Vector3d u = up.sample(p) + fluc;  // Eq. (9)
       const int nsub = substepsFor(u.norm() * dt, st.substepCapped);
       const double h = dt / nsub;

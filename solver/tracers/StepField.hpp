@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "tracers/BlockSampling.hpp"
 #include "tracers/FrameSampler.hpp"
 
 namespace rcfd {
@@ -46,6 +47,28 @@ class StepVelocityField {
 
  private:
   std::vector<Eigen::Array4f> data_;
+};
+
+/// u at single points of a step field, with the motion kernel's block arithmetic
+/// (block::interpolateCorners, float) for one point: the motion kernel's scalar path and the spray
+/// parcels sample with it.
+class StepFieldSampler {
+ public:
+  StepFieldSampler(const StepVelocityField& field, const TrilinearLocator& locator) : field_(field), locator_(locator) {
+    corners_.set(locator.offsets32());
+  }
+  Eigen::Vector3d sample(const Eigen::Vector3d& p) const {
+    const TrilinearStencil s = locator_.locate(p);
+    float u[3];
+    block::interpolateCorners(field_.floats() + 4 * s.base, corners_.off4, float(s.f[0]), float(s.f[1]),
+                              float(s.f[2]), u);
+    return {double(u[0]), double(u[1]), double(u[2])};
+  }
+
+ private:
+  const StepVelocityField& field_;
+  const TrilinearLocator& locator_;
+  block::CornerOffsets corners_;
 };
 
 }  // namespace rcfd
