@@ -178,15 +178,20 @@ class DepositionEffect final : public TracerEffect {
     for (const auto& range : found_) {
       for (const std::int32_t i : range) members_[std::size_t(cursor_[std::size_t(slotOf[cellOf[i]])]++)] = i;
     }
+    // Slots in parallel: each draws from its cell's own stream and writes only its cell's tracers, so
+    // the result is the same for any thread count; `assigned` sums whole numbers, exact in any order.
+    double assigned = 0.0;
+#pragma omp parallel for schedule(dynamic, 16) reduction(+ : assigned) if (parallel)
     for (std::size_t k = 0; k < slots; ++k) {
       const std::int32_t c = slotCells_[k];
       slot_[std::size_t(c)] = -1;
       CounterRng rng(ctx.seed, RngPurpose::Deposition, std::uint64_t(c), std::uint64_t(ctx.step));
       distribute(rng, std::int64_t(due_[std::size_t(c)]), std::size_t(slotStart_[k]), std::size_t(slotStart_[k + 1]),
                  s.tracerDroplets);
-      s.assigned += double(due_[std::size_t(c)]);
+      assigned += double(due_[std::size_t(c)]);
       due_[std::size_t(c)] = 0;
     }
+    s.assigned += assigned;
   }
 
   /// Hands `droplets` whole droplets to the tracers members_[start, end) with equal probability each: a

@@ -59,6 +59,11 @@ class TracerSimulation {
   /// Bytes allocated by each effect (0 for an effect not built: it does not exist).
   std::size_t allocatedBytes(const std::string& effect) const;
 
+  /// Reorders the tracers by cell (stable: by index within a cell), with every effect's per-tracer
+  /// state, and hands the cells to tracer_volume_fraction. step() calls it at every multiple of
+  /// settings().sortInterval.
+  void sortTracers();
+
   void saveCheckpoint(const std::string& path) const;
   void loadCheckpoint(const std::string& path);
   /// Writes result.h5 content and fills the summary with every effect's figures.
@@ -77,9 +82,6 @@ class TracerSimulation {
 
  private:
   void placeTracers();
-  /// Reorders the tracers by cell (stable: by index within a cell), with every effect's per-tracer
-  /// state, and hands the cells to tracer_volume_fraction.
-  void sortTracers();
   void loadFrames();
 
   Scene scene_;

@@ -172,6 +172,30 @@ TEST(Spray, PaperParametersGiveNineteenThousandDropletsAndNinetyPercentCoverage)
   EXPECT_NEAR(summary["coverage"]["median"].get<double>(), 0.90, 0.015);
 }
 
+TEST(Spray, SortingKeepsEveryTracersDropletsAndPosition) {
+  Scene s = sprayBoxScene(6000, 0.4, 0.1);
+  auto db = sprayBoxDatabase(s, 0.4, 0.1, 3.0);
+  const std::int64_t steps = 40;
+  TracerSimulation sim(s, db, sequentialPath(db->frameCount(), steps + 2), {21, steps, 0, true, 0});
+  for (std::int64_t k = 0; k < steps; ++k) sim.step();
+  const TracerSimulation& view = sim;
+  const auto& cloud = view.cloud();
+  const auto droplets = cloud.inIdOrder(view.context().spray->tracerDroplets);
+  const auto x = cloud.inIdOrder(cloud.x), y = cloud.inIdOrder(cloud.y);
+  const auto idsBefore = cloud.id;
+  ASSERT_GT(*std::max_element(droplets.begin(), droplets.end()), 0.0);
+  sim.sortTracers();
+  EXPECT_NE(cloud.id, idsBefore);  // the tracers did move in memory
+  EXPECT_EQ(cloud.inIdOrder(view.context().spray->tracerDroplets), droplets);
+  EXPECT_EQ(cloud.inIdOrder(cloud.x), x);
+  EXPECT_EQ(cloud.inIdOrder(cloud.y), y);
+  // Sorted: cells never decrease along the storage order.
+  const CartesianGrid& grid = view.context().grid;
+  for (std::size_t i = 1; i < cloud.size(); ++i) {
+    ASSERT_LE(grid.flatIndexOf(cloud.position(i - 1)), grid.flatIndexOf(cloud.position(i))) << i;
+  }
+}
+
 TEST(Spray, OneAndTwoThreadsAndResumeAreBitIdentical) {
   Scene s = sprayBoxScene(6000, 0.4, 0.1);  // above the parallel threshold: threads really split work
   s.effects.push_back("fluctuation");
@@ -180,14 +204,16 @@ TEST(Spray, OneAndTwoThreadsAndResumeAreBitIdentical) {
   auto run = [&](int threads, std::int64_t checkpointAt) {
     omp_set_num_threads(threads);
     const RecurrencePath path = sequentialPath(db->frameCount(), steps + 2);
-    TracerSimulation sim(s, db, path, {21, steps, 0});
+    // Re-sorted by cell every 7 steps: the droplets per tracer move with their tracers, across the resume.
+    const TracerRunSettings settings{21, steps, 0, true, 7};
+    TracerSimulation sim(s, db, path, settings);
     std::unique_ptr<TracerSimulation> resumed;
     TracerSimulation* active = &sim;
     const std::string checkpoint = tempPath("spray-checkpoint.h5");
     for (std::int64_t k = 0; k < steps; ++k) {
       if (k == checkpointAt) {
         sim.saveCheckpoint(checkpoint);
-        resumed = std::make_unique<TracerSimulation>(s, db, path, TracerRunSettings{21, steps, 0});
+        resumed = std::make_unique<TracerSimulation>(s, db, path, settings);
         resumed->loadCheckpoint(checkpoint);
         active = resumed.get();
       }
