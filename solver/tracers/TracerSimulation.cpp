@@ -269,9 +269,19 @@ void TracerSimulation::loadCheckpoint(const std::string& path) {
   cloud_.vx = f.readDoubles("/cloud/vx");
   cloud_.vy = f.readDoubles("/cloud/vy");
   cloud_.vz = f.readDoubles("/cloud/vz");
-  if (f.exists("/cloud/id")) {  // checkpoints from before sorting keep the identity order
-    const auto id = f.readInt64s("/cloud/id");
-    for (std::size_t i = 0; i < cloud_.size(); ++i) cloud_.id.at(i) = std::int32_t(id.at(i));
+  // The tracers' identities (checkpoints from before the sort by cell: the identity order). A
+  // damaged list would send per-tracer results to the wrong tracers: it must be a permutation.
+  const std::size_t n = cloud_.size();
+  std::vector<std::int64_t> id(n);
+  for (std::size_t i = 0; i < n; ++i) id[i] = std::int64_t(i);
+  if (f.exists("/cloud/id")) id = f.readInt64s("/cloud/id");
+  std::vector<char> seen(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (id.size() != n || id[i] < 0 || id[i] >= std::int64_t(n) || seen[std::size_t(id[i])]) {
+      throw InputError(path, "/cloud/id", "must list every tracer id 0.." + std::to_string(n - 1) + " once");
+    }
+    seen[std::size_t(id[i])] = 1;
+    cloud_.id[i] = std::int32_t(id[i]);
   }
   context_->step = f.readInt64s("/state/step").at(0);
   context_->nextTracerCellStep = -1;  // the positions came from the file

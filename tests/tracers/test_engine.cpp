@@ -151,6 +151,29 @@ TEST(Determinism, ResumedRunEqualsUninterruptedRun) {
   EXPECT_EQ(straight.summary.dump(), resumed.summary.dump());
 }
 
+TEST(Determinism, ACheckpointWithDamagedTracerIdsIsRefused) {
+  const Scene s = fullTracerScene();
+  auto db = swirlingDatabase(s, 12);
+  const RecurrencePath path = sequentialPath(db->frameCount(), 12);
+  TracerSimulation sim(s, db, path, {42, 10, 0});
+  for (int k = 0; k < 3; ++k) sim.step();
+  const std::string checkpoint = tempPath("engine-damaged-ids.h5");
+  sim.saveCheckpoint(checkpoint);
+  {
+    h5::File f(checkpoint, h5::File::Mode::ReadWrite);
+    std::vector<std::int64_t> id = f.readInt64s("/cloud/id");
+    id[1] = id[0];  // one tracer twice, another missing
+    f.write("/cloud/id", id);
+  }
+  TracerSimulation resumed(s, db, path, {42, 10, 0});
+  try {
+    resumed.loadCheckpoint(checkpoint);
+    FAIL() << "a damaged id list was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/cloud/id"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Determinism, SortingTheTracersChangesNoResult) {
   // Every tracer draws from its own stream (by id) and the per-cell counts are integers, so the order
   // the tracers are stored in is invisible: never sorted and sorted every 7 steps agree bit for bit.
