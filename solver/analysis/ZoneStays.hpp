@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "core/Permutation.hpp"
+
 namespace rcfd {
 
 namespace h5 {
@@ -65,11 +67,7 @@ class ZoneStays {
   }
 
   /// The members were reordered: member j is the one that was member from[j].
-  void permute(const std::vector<std::int32_t>& from) {
-    std::vector<std::int64_t> e(entry_.size());
-    for (std::size_t j = 0; j < e.size(); ++j) e[j] = entry_[std::size_t(from[j])];
-    entry_.swap(e);
-  }
+  void permute(const std::vector<std::int32_t>& from) { applyPermutation(entry_, from); }
 
   /// Adds completed stays (durations in samples) to the histogram of durations.
   void addDurations(const std::vector<std::int64_t>& durations);

@@ -2,6 +2,8 @@
 
 #include <numbers>
 
+#include "core/Permutation.hpp"
+
 namespace rcfd {
 
 std::size_t DemParticles::add(const Vec3& pos, const Vec3& vel, double r, double density) {
@@ -19,15 +21,6 @@ std::size_t DemParticles::add(const Vec3& pos, const Vec3& vel, double r, double
   id.push_back(id.size());
   return x.size() - 1;
 }
-
-namespace {
-template <class T>
-void applyPermutation(std::vector<T>& a, const std::vector<std::size_t>& perm) {
-  std::vector<T> out(a.size());
-  for (std::size_t k = 0; k < perm.size(); ++k) out[k] = a[perm[k]];
-  a.swap(out);
-}
-}  // namespace
 
 void DemParticles::permute(const std::vector<std::size_t>& perm) {
   applyPermutation(x, perm); applyPermutation(v, perm); applyPermutation(omega, perm);

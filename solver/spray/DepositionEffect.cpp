@@ -15,6 +15,7 @@
 #include <memory>
 #include <random>
 
+#include "core/Permutation.hpp"
 #include "spray/DepositionEfficiency.hpp"
 #include "spray/SprayState.hpp"
 #include "tracers/CounterRng.hpp"
@@ -54,10 +55,7 @@ class DepositionEffect final : public TracerEffect {
   }
 
   void permuteTracers(TracerContext&, const std::vector<std::int32_t>& from) override {
-    auto& d = state_->tracerDroplets;
-    std::vector<double> moved(d.size());
-    for (std::size_t j = 0; j < d.size(); ++j) moved[j] = d[std::size_t(from[j])];
-    d.swap(moved);
+    applyPermutation(state_->tracerDroplets, from);
   }
 
   void saveState(h5::File& f, const std::string& g) const override {

@@ -133,8 +133,8 @@ class SprayEffect final : public TracerEffect {
   void moveParcels(TracerContext& ctx, SprayState& s) {
     auto& pc = s.parcels;
     const std::int64_t n = std::int64_t(pc.size());
-    std::vector<std::int8_t> exit(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
     if (n == 0) return;
+    std::vector<std::int8_t> exit(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
     const FrameSampler frames = ctx.sampler();
     // u_G^rec of the step as a 4-float step field, blended once per cell: a parcel sub-step then reads
     // its corners like a tracer (float trilinear, block::interpolateCorners) instead of blending and

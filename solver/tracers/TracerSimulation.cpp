@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "core/Errors.hpp"
+#include "core/Permutation.hpp"
 #include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 
@@ -192,25 +193,21 @@ void TracerSimulation::sortTracers() {
   // Scratch kept between sorts (fresh arrays would cost their page faults every time) and swapped
   // with the arrays they replace.
   auto& s = sortScratch_;
-  s.cell.resize(n), s.from.resize(n), s.ints.resize(n), s.doubles.resize(n);
+  s.cell.resize(n), s.from.resize(n);
   s.start.assign(cells + 1, 0);
   CellIndexer(ctx.grid).cellsOf(int(n), cloud_.x.data(), cloud_.y.data(), cloud_.z.data(), s.cell.data());
   // Counting sort by cell, stable: the same order for any thread count and on resume.
   for (const std::int32_t c : s.cell) ++s.start[std::size_t(c) + 1];
   for (std::size_t c = 0; c < cells; ++c) s.start[c + 1] += s.start[c];
   for (std::size_t i = 0; i < n; ++i) s.from[std::size_t(s.start[std::size_t(s.cell[i])]++)] = std::int32_t(i);
-  const std::int32_t* from = s.from.data();
-  auto reorder = [&](auto& values, auto& scratch) {
-#pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
-    for (std::int64_t j = 0; j < std::int64_t(n); ++j) scratch[std::size_t(j)] = values[std::size_t(from[j])];
-    values.swap(scratch);
-  };
-  reorder(cloud_.x, s.doubles), reorder(cloud_.y, s.doubles), reorder(cloud_.z, s.doubles);
-  if (keepsVelocities_) reorder(cloud_.vx, s.doubles), reorder(cloud_.vy, s.doubles), reorder(cloud_.vz, s.doubles);
-  reorder(cloud_.id, s.ints);
+  for (auto* values : {&cloud_.x, &cloud_.y, &cloud_.z}) applyPermutation(*values, s.from, s.doubles);
+  if (keepsVelocities_) {
+    for (auto* values : {&cloud_.vx, &cloud_.vy, &cloud_.vz}) applyPermutation(*values, s.from, s.doubles);
+  }
+  applyPermutation(cloud_.id, s.from, s.ints);
   for (auto& e : effects_) e->permuteTracers(ctx, s.from);
   if (ctx.nextTracerCell.size() == n) {  // the cells are known: tracer_volume_fraction takes them
-    reorder(s.cell, s.ints);
+    applyPermutation(s.cell, s.from, s.ints);
     ctx.nextTracerCell.swap(s.cell);
     ctx.nextTracerCellStep = ctx.step;
   } else {
