@@ -12,18 +12,10 @@
 namespace rcfd::gas {
 namespace {
 
-/// van Leer limited slope from the two one-sided differences (0 at an extremum).
-inline double limitedSlope(double forward, double backward) {
-  const double prod = forward * backward;
-  return prod > 0.0 ? 2.0 * prod / (forward + backward) : 0.0;
-}
-
 /// Safety factor on the explicit-diffusion stability bound dt <= 1 / (2 nu sum_d 1/h_d^2).
 constexpr double kViscousSafety = 0.9;
 /// Safety factor on the explicit nozzle-source bound dt <= alpha / s.
 constexpr double kSourceSafety = 0.5;
-/// Face loops below this size run serially (fork/join and barrier costs dominate).
-constexpr std::size_t kParallelFaces = 100000;
 
 std::string cellText(const CartesianGrid& g, std::size_t c) {
   const auto ijk = g.cellIjk(std::int64_t(c));
@@ -56,6 +48,7 @@ GasSolver::GasSolver(const Scene& scene, const Apparatus& apparatus, const Carte
   p_.assign(n, 0.0);
   ap_ = computeFaceApertures(apparatus_, grid_);
   buildTopology();
+  buildStencils();
   buildNozzle();
   source0_ = source_;
   inletVelocity0_ = inletVelocity_;
@@ -290,143 +283,6 @@ double GasSolver::convectiveRate() const {
         rate = std::max(rate, ux / h.x() + uy / h.y() + uz / h.z());
       }
   return rate;
-}
-
-double GasSolver::ghostValue(const std::vector<double>& u, int d, int e, std::array<int, 3> idx) const {
-  // Out-of-range neighbours of a face value of axis d. Along d: the boundary face itself. Across: a
-  // mirror image, odd (no-slip wall, inlet with no tangential velocity), even (slip front/back
-  // walls) or a copy (zero gradient at the outlet on top).
-  const auto& s = ap_.shape[std::size_t(d)];
-  double sign = 1.0;
-  for (int a = 0; a < 3; ++a) {
-    int& x = idx[std::size_t(a)];
-    const int nA = s[std::size_t(a)];
-    if (x >= 0 && x < nA) continue;
-    if (a == d) {
-      x = std::clamp(x, 0, nA - 1);
-      continue;
-    }
-    const bool high = x >= nA;
-    if (a == 1 && high) {
-      x = nA - 1;
-      continue;
-    }
-    x = high ? 2 * nA - 1 - x : -1 - x;
-    x = std::clamp(x, 0, nA - 1);
-    const bool slip = (a == 2 && options_.slipFrontBack) || (a == 0 && options_.slipSideWalls);
-    if (!slip) sign = -sign;
-  }
-  (void)e;
-  return sign * u[faceIndex(d, idx[0], idx[1], idx[2])];
-}
-
-bool GasSolver::baffleAhead(int d, int e, std::array<int, 3> idx) const {
-  // Face idx of axis d lies between cells idx - e_d and idx; a step along +e leaves both cells through
-  // their e-faces at index + 1: a baffle when it closes both (a plate tip closing one is no wall).
-  if (idx[std::size_t(e)] < 0 || idx[std::size_t(e)] >= grid_.shape[std::size_t(e)]) return false;
-  idx[std::size_t(e)] += 1;
-  std::array<int, 3> lo = idx;
-  lo[std::size_t(d)] -= 1;
-  return ap_.baffles.closes(e, idx[0], idx[1], idx[2]) && ap_.baffles.closes(e, lo[0], lo[1], lo[2]);
-}
-
-void GasSolver::mirrorAtBaffles(int d, int e, const std::array<int, 3>& idx, double v[5]) const {
-  // A baffle lies midway between two neighbouring face values of axis d along e != d: the values behind
-  // it are replaced by the odd mirror image of those in front (no-slip, as at the outer walls), so no
-  // momentum is advected or diffused through a plate.
-  auto shifted = [&](int m) {
-    std::array<int, 3> q = idx;
-    q[std::size_t(e)] += m;
-    return q;
-  };
-  if (baffleAhead(d, e, idx)) {
-    v[3] = -v[2], v[4] = -v[1];
-  } else if (baffleAhead(d, e, shifted(1))) {
-    v[4] = -v[3];
-  }
-  if (baffleAhead(d, e, shifted(-1))) {
-    v[1] = -v[2], v[0] = -v[3];
-  } else if (baffleAhead(d, e, shifted(-2))) {
-    v[0] = -v[1];
-  }
-}
-
-void GasSolver::explicitRates(const std::array<std::vector<double>, 3>& u,
-                              std::array<std::vector<double>, 3>& rate) const {
-  const Eigen::Vector3d h = grid_.spacing;
-  const double nu = scene_.gas.kinematic_viscosity, rho = scene_.gas.density;
-  for (int d = 0; d < 3; ++d) {
-    const auto& s = ap_.shape[std::size_t(d)];
-    const auto& ud = u[std::size_t(d)];
-    const auto& kinds = kind_[std::size_t(d)];
-    auto& out = rate[std::size_t(d)];
-    const std::array<std::size_t, 3> stride{1, std::size_t(s[0]), std::size_t(s[0]) * s[1]};
-    const bool parallel = ud.size() > kParallelFaces;
-#pragma omp parallel for collapse(2) schedule(static) if (parallel)
-    for (int k = 0; k < s[2]; ++k)
-      for (int j = 0; j < s[1]; ++j)
-        for (int i = 0; i < s[0]; ++i) {
-          const std::size_t f = faceIndex(d, i, j, k);
-          if (kinds[f] != Interior) {
-            out[f] = 0.0;
-            continue;
-          }
-          const std::array<int, 3> idx{i, j, k};
-          std::array<int, 3> lo = idx;
-          lo[std::size_t(d)] -= 1;
-          double r = 0.0;
-          for (int e = 0; e < 3; ++e) {
-            // Transport velocity component e at this face: itself along d, else the mean of the four
-            // e-faces of the two cells beside the face (the MAC average).
-            double a;
-            if (e == d) {
-              a = ud[f];
-            } else {
-              const auto& ue = u[std::size_t(e)];
-              std::array<int, 3> up = idx, upLo = lo;
-              up[std::size_t(e)] += 1;
-              upLo[std::size_t(e)] += 1;
-              a = 0.25 * (ue[faceIndex(e, idx[0], idx[1], idx[2])] + ue[faceIndex(e, up[0], up[1], up[2])] +
-                          ue[faceIndex(e, lo[0], lo[1], lo[2])] + ue[faceIndex(e, upLo[0], upLo[1], upLo[2])]);
-            }
-            double v[5];  // offsets -2 .. +2 along e
-            const int x = idx[std::size_t(e)];
-            if (x >= 2 && x + 2 < s[std::size_t(e)]) {
-              for (int m = -2; m <= 2; ++m) v[m + 2] = ud[f + std::ptrdiff_t(m) * std::ptrdiff_t(stride[std::size_t(e)])];
-            } else {
-              for (int m = -2; m <= 2; ++m) {
-                std::array<int, 3> q = idx;
-                q[std::size_t(e)] += m;
-                v[m + 2] = (q[std::size_t(e)] >= 0 && q[std::size_t(e)] < s[std::size_t(e)])
-                               ? ud[faceIndex(d, q[0], q[1], q[2])]
-                               : ghostValue(ud, d, e, q);
-              }
-            }
-            if (e != d && !ap_.baffles.empty()) mirrorAtBaffles(d, e, idx, v);
-            // Second-order upwind with a van Leer limiter (first order at extrema): the advective
-            // derivative a dphi/dx from limited upwind values at the two half-points.
-            double plus, minus;
-            if (a >= 0) {
-              plus = v[2] + 0.5 * limitedSlope(v[3] - v[2], v[2] - v[1]);
-              minus = v[1] + 0.5 * limitedSlope(v[2] - v[1], v[1] - v[0]);
-            } else {
-              plus = v[3] - 0.5 * limitedSlope(v[4] - v[3], v[3] - v[2]);
-              minus = v[2] - 0.5 * limitedSlope(v[3] - v[2], v[2] - v[1]);
-            }
-            r -= a * (plus - minus) / h[e];
-            r += nu * (v[3] - 2 * v[2] + v[1]) / (h[e] * h[e]);  // alpha grad.tau / (alpha rho), Eq. (2)
-          }
-          const std::size_t cl = std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]));
-          const std::size_t ch = std::size_t(grid_.flatIndex(i, j, k));
-          const double aF = 0.5 * (alphaNext_[cl] + alphaNext_[ch]);
-          const double fe = 0.5 * (fExplicit_[cl][d] + fExplicit_[ch][d]);
-          // Nozzle air enters with the jet velocity (+y): s (u_jet - u) / alpha, explicit.
-          const double sF = 0.5 * (source_[cl] + source_[ch]);
-          const double jet = d == 1 ? nozzleJetVelocity_ : 0.0;
-          r += options_.gravity[d] + fe / (aF * rho) + sF * (jet - ud[f]) / aF;
-          out[f] = r;
-        }
-  }
 }
 
 double GasSolver::step(double maxDt) {

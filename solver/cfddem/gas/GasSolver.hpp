@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -143,7 +144,13 @@ class GasSolver {
   double chooseDt(double maxDt) const;
   double convectiveRate() const;
   void explicitRates(const std::array<std::vector<double>, 3>& u, std::array<std::vector<double>, 3>& rate) const;
-  double ghostValue(const std::vector<double>& u, int d, int e, std::array<int, 3> idx) const;
+  /// Tabulates the ghost values of the rates' stencils and the faces near baffles (GasAdvection.cpp).
+  void buildStencils();
+  /// The explicit rate of face (i, j, k) of axis d (0 for a face that is not interior).
+  double faceRate(const std::array<std::vector<double>, 3>& u, int d, int i, int j, int k) const;
+  /// faceRate of the faces i0 <= i < i1 of row (j, k) of axis d into out (the axis' rate array),
+  /// vectorised; only for faces with their x-stencil inside the grid and both cells along d.
+  void rowRates(const std::array<std::vector<double>, 3>& u, int d, int j, int k, int i0, int i1, double* out) const;
   /// Whether a baffle (thin plate) closes the way from face idx of axis d to its neighbour at +e.
   bool baffleAhead(int d, int e, std::array<int, 3> idx) const;
   /// Stencil values v[0..4] (offsets -2..2 along e of face idx, axis d): no-slip mirror at baffles.
@@ -179,6 +186,14 @@ class GasSolver {
   std::vector<double> p_;
   Eigen::VectorXd q_;             ///< p dt / rho of the last solve (warm start)
   std::unique_ptr<PressureSolver> pressureSolver_;
+  /// Stencil point of explicitRates: the face value at offset m along e of a face at index x along e
+  /// is sign * u[face + shift * stride_e] (shift = m inside the grid, a mirror or copy outside).
+  struct GhostPoint {
+    int shift = 0;
+    double sign = 1.0;
+  };
+  std::array<std::array<std::vector<GhostPoint>, 3>, 3> ghost_;  ///< [d][e][x * 5 + m + 2]
+  std::array<std::vector<std::uint8_t>, 3> nearBaffle_;          ///< [d][face]: bit e, empty without baffles
   GasStepStats last_;
   double time_ = 0.0;
   double lastDt_ = 0.0;
