@@ -1,6 +1,7 @@
 // GasSolver::project(): the pressure Poisson equation of the fractional step and the continuity
 // residual, Eq. (1) (GasSolver.hpp).
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -26,8 +27,11 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
   // The matrix depends on alpha_G and on the drag factor D (with dt): rebuilt only when those may have
   // changed.
   const bool rebuild = matrixDirty_ || hasDrag_ || pressureSolver_->matrix().rows() != unknowns;
-  std::vector<Eigen::Triplet<double>> triplets;
-  if (rebuild) triplets.reserve(std::size_t(unknowns) * 7);
+  if (rebuild) {
+    if (matrix_.rows() != unknowns) buildMatrixPattern();
+    std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  }
+  double* const values = matrix_.valuePtr();
   for (std::size_t c = 0; c < alpha_.size(); ++c) {
     const int r = unknown_[c];
     if (r < 0) continue;
@@ -52,20 +56,20 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
           if (rLo >= 0) b[rLo] -= flux, scale[rLo] += std::abs(flux);
           if (rHi >= 0) b[rHi] += flux, scale[rHi] += std::abs(flux);
           if (!rebuild) continue;
+          const auto& slot = matrixSlot_[std::size_t(d)][f];
           if (kind == Interior) {
             const double cf = aaa * diag[std::size_t(d)][f] / h[d];
-            triplets.emplace_back(rLo, rLo, cf);
-            triplets.emplace_back(rHi, rHi, cf);
-            triplets.emplace_back(rLo, rHi, -cf);
-            triplets.emplace_back(rHi, rLo, -cf);
+            values[slot[0]] += cf;
+            values[slot[1]] += cf;
+            values[slot[2]] -= cf;
+            values[slot[3]] -= cf;
           } else if (kind == Outlet) {
-            triplets.emplace_back(rLo, rLo, 2 * aaa / h[d]);
+            values[slot[0]] += 2 * aaa / h[d];
           }
         }
   }
   if (rebuild) {
-    PressureSolver::Matrix m(unknowns, unknowns);
-    m.setFromTriplets(triplets.begin(), triplets.end());
+    const PressureSolver::Matrix& m = matrix_;
     // Unchanged values (alpha_G set again to the same field) keep the preconditioner.
     const bool same = m.nonZeros() == pressureSolver_->matrix().nonZeros() &&
                       m.rows() == pressureSolver_->matrix().rows() &&
@@ -98,6 +102,63 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
     absTol *= 0.5 * tol / last_.divergence.relative;
   }
   for (std::size_t c = 0; c < alpha_.size(); ++c) p_[c] = unknown_[c] >= 0 ? q_[unknown_[c]] * rho / dt : 0.0;
+}
+
+// The matrix's sparsity follows the topology alone (which faces are interior or outlet), so it is set
+// up once; each rebuild refills the values in place through the faces' slots, in the order the faces
+// are visited (the sums of the diagonal are those a triplet assembly would form).
+void GasSolver::buildMatrixPattern() {
+  const auto n = grid_.shape;
+  const int unknowns = int(q_.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(std::size_t(unknowns) * 7);
+  auto unknownsOf = [&](int d, int i, int j, int k) {
+    std::array<int, 3> lo{i, j, k};
+    lo[std::size_t(d)] -= 1;
+    const int rLo = lo[std::size_t(d)] >= 0 ? unknown_[std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]))] : -1;
+    const int rHi = i < n[0] && j < n[1] && k < n[2] ? unknown_[std::size_t(grid_.flatIndex(i, j, k))] : -1;
+    return std::array<int, 2>{rLo, rHi};
+  };
+  for (int d = 0; d < 3; ++d) {
+    const auto& s = ap_.shape[std::size_t(d)];
+    matrixSlot_[std::size_t(d)].assign(kind_[std::size_t(d)].size(), {0, 0, 0, 0});
+    for (int k = 0; k < s[2]; ++k)
+      for (int j = 0; j < s[1]; ++j)
+        for (int i = 0; i < s[0]; ++i) {
+          const char kind = kind_[std::size_t(d)][faceIndex(d, i, j, k)];
+          const auto [rLo, rHi] = unknownsOf(d, i, j, k);
+          if (kind == Interior) {
+            triplets.emplace_back(rLo, rLo, 1.0);
+            triplets.emplace_back(rHi, rHi, 1.0);
+            triplets.emplace_back(rLo, rHi, 1.0);
+            triplets.emplace_back(rHi, rLo, 1.0);
+          } else if (kind == Outlet) {
+            triplets.emplace_back(rLo, rLo, 1.0);
+          }
+        }
+  }
+  matrix_ = PressureSolver::Matrix(unknowns, unknowns);
+  matrix_.setFromTriplets(triplets.begin(), triplets.end());
+  matrix_.makeCompressed();
+  auto slotOf = [&](int row, int col) {
+    const int* inner = matrix_.innerIndexPtr();
+    const int* begin = inner + matrix_.outerIndexPtr()[row];
+    const int* end = inner + matrix_.outerIndexPtr()[row + 1];
+    return int(std::lower_bound(begin, end, col) - inner);
+  };
+  for (int d = 0; d < 3; ++d) {
+    const auto& s = ap_.shape[std::size_t(d)];
+    for (int k = 0; k < s[2]; ++k)
+      for (int j = 0; j < s[1]; ++j)
+        for (int i = 0; i < s[0]; ++i) {
+          const std::size_t f = faceIndex(d, i, j, k);
+          const char kind = kind_[std::size_t(d)][f];
+          const auto [rLo, rHi] = unknownsOf(d, i, j, k);
+          auto& slot = matrixSlot_[std::size_t(d)][f];
+          if (kind == Interior) slot = {slotOf(rLo, rLo), slotOf(rHi, rHi), slotOf(rLo, rHi), slotOf(rHi, rLo)};
+          else if (kind == Outlet) slot[0] = slotOf(rLo, rLo);
+        }
+  }
 }
 
 // Corrects the face velocities with the pressure gradient: u = u* - D (q_hi - q_lo) / h.

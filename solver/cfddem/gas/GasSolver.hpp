@@ -157,6 +157,8 @@ class GasSolver {
   void mirrorAtBaffles(int d, int e, const std::array<int, 3>& idx, double v[5]) const;
   double faceAlpha(int d, std::size_t f, int i, int j, int k) const;
   void project(double dt, const std::array<std::vector<double>, 3>& diag);
+  /// Sets up matrix_'s sparsity and the faces' slots in it (GasProjection.cpp).
+  void buildMatrixPattern();
   void correct(const std::array<std::vector<double>, 3>& diag);
   DivergenceResidual divergence(double dt) const;
   void checkAlpha(const std::vector<double>& alpha, const char* what) const;
@@ -186,6 +188,10 @@ class GasSolver {
   std::vector<double> p_;
   Eigen::VectorXd q_;             ///< p dt / rho of the last solve (warm start)
   std::unique_ptr<PressureSolver> pressureSolver_;
+  PressureSolver::Matrix matrix_;  ///< the pressure matrix: pattern fixed by the topology, values refilled
+  /// Per axis and face: indices in matrix_'s values of (lo, lo), (hi, hi), (lo, hi), (hi, lo) of an
+  /// interior face, [0] = (lo, lo) of an outlet face.
+  std::array<std::vector<std::array<int, 4>>, 3> matrixSlot_;
   /// Stencil point of explicitRates: the face value at offset m along e of a face at index x along e
   /// is sign * u[face + shift * stride_e] (shift = m inside the grid, a mirror or copy outside).
   struct GhostPoint {
