@@ -21,7 +21,7 @@ inline double limitedSlope(double forward, double backward) {
 }
 
 /// Face loops below this size run serially (fork/join and barrier costs dominate).
-constexpr std::size_t kParallelFaces = 100000;
+constexpr std::size_t kParallelFaces = 10000;
 
 }  // namespace
 
