@@ -11,20 +11,44 @@ namespace {
 /// Levels stop coarsening below this many unknowns: the coarsest is solved by sparse Cholesky.
 constexpr int kCoarsestUnknowns = 400;
 
-/// One symmetric-Gauss-Seidel half sweep on a row-major matrix (forward or backward).
-void gaussSeidel(const AggregationMultigrid::Matrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x, bool forward) {
+/// One symmetric-Gauss-Seidel half sweep (forward or backward), on the rows split into off-diagonal
+/// entries and diagonal: the same sums in the same order as a sweep over the full rows.
+template <class SplitRows>
+void gaussSeidel(const SplitRows& a, const Eigen::VectorXd& b, Eigen::VectorXd& x, bool forward) {
+  const int n = int(a.diagonal.size());
+  const int* start = a.start.data();
+  const int* column = a.column.data();
+  const double* value = a.value.data();
+  const double* diagonal = a.diagonal.data();
+  double* const xs = x.data();
+  for (int s = 0; s < n; ++s) {
+    const int r = forward ? s : n - 1 - s;
+    double sum = b[r];
+    for (int q = start[r]; q < start[r + 1]; ++q) sum -= value[q] * xs[column[q]];
+    xs[r] = sum / diagonal[r];
+  }
+}
+
+template <class SplitRows, class Matrix>
+void splitRows(const Matrix& a, SplitRows& out) {
   const int n = int(a.rows());
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-  for (int s = 0; s < n; ++s) {
-    const int r = forward ? s : n - 1 - s;
-    double sum = b[r], diag = 0.0;
+  out.start.assign(std::size_t(n) + 1, 0);
+  out.column.clear();
+  out.value.clear();
+  out.diagonal.assign(std::size_t(n), 0.0);
+  for (int r = 0; r < n; ++r) {
     for (int q = outer[r]; q < outer[r + 1]; ++q) {
-      if (inner[q] == r) diag = val[q];
-      else sum -= val[q] * x[inner[q]];
+      if (inner[q] == r) {
+        out.diagonal[std::size_t(r)] = val[q];
+      } else {
+        out.column.push_back(inner[q]);
+        out.value.push_back(val[q]);
+      }
     }
-    x[r] = sum / diag;
+    out.start[std::size_t(r) + 1] = int(out.column.size());
   }
 }
 
@@ -35,7 +59,7 @@ AggregationMultigrid::~AggregationMultigrid() = default;
 
 void AggregationMultigrid::compute(const Matrix& a) {
   levels_.clear();
-  levels_.push_back({a, {}, 0});
+  levels_.push_back({a, {}, 0, {}});
   std::vector<std::array<int, 3>> cells = cellOf_;
   while (levels_.back().a.rows() > kCoarsestUnknowns) {
     Level& fine = levels_.back();
@@ -58,9 +82,10 @@ void AggregationMultigrid::compute(const Matrix& a) {
     p.setFromTriplets(t.begin(), t.end());
     const Eigen::SparseMatrix<double> af = fine.a;
     Eigen::SparseMatrix<double> ac = Eigen::SparseMatrix<double>(p.transpose()) * af * p;
-    levels_.push_back({Matrix(ac), {}, 0});
+    levels_.push_back({Matrix(ac), {}, 0, {}});
     cells = std::move(coarseCells);
   }
+  for (std::size_t l = 0; l + 1 < levels_.size(); ++l) splitRows(levels_[l].a, levels_[l].split);
   coarse_.compute(Eigen::SparseMatrix<double>(levels_.back().a));
   if (coarse_.info() != Eigen::Success) throw std::runtime_error("multigrid: coarsest-level factorisation failed");
 }
@@ -72,7 +97,7 @@ void AggregationMultigrid::cycle(int l, const Eigen::VectorXd& b, Eigen::VectorX
   }
   const Level& L = levels_[std::size_t(l)];
   x.setZero(b.size());
-  gaussSeidel(L.a, b, x, true);
+  gaussSeidel(L.split, b, x, true);
   // Residual restricted to the aggregates in one row loop (Eigen's b - A x expression was 4% of a
   // coupled CFD-DEM step).
   Eigen::VectorXd rc = Eigen::VectorXd::Zero(L.coarseCount), xc;
@@ -89,7 +114,7 @@ void AggregationMultigrid::cycle(int l, const Eigen::VectorXd& b, Eigen::VectorX
   }
   cycle(l + 1, rc, xc);
   for (int i = 0; i < int(x.size()); ++i) x[i] += xc[L.coarseOf[std::size_t(i)]];
-  gaussSeidel(L.a, b, x, false);
+  gaussSeidel(L.split, b, x, false);
 }
 
 void AggregationMultigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const { cycle(0, r, z); }

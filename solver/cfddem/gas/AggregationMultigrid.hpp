@@ -29,10 +29,17 @@ class AggregationMultigrid {
   int levels() const { return int(levels_.size()); }
 
  private:
+  /// A level's matrix split for Gauss-Seidel: the off-diagonal entries of each row in row order, and
+  /// the diagonal (no search for it inside the sweep).
+  struct SplitRows {
+    std::vector<int> start, column;
+    std::vector<double> value, diagonal;
+  };
   struct Level {
     Matrix a;
     std::vector<int> coarseOf;  ///< aggregate of each unknown on the next level
     int coarseCount = 0;
+    SplitRows split;
   };
   void cycle(int l, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 
