@@ -139,15 +139,26 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
       }
     }
   };
-#pragma omp parallel for schedule(dynamic, 256) if (n >= kDemParallelMinParticles)
-  for (long i = 0; i < n; ++i) {
-    Index count = 0;
-    visit(i, [&](Index) { ++count; });
-    row_start[i + 1] = count;
-    Index wc = 0;
-    for (std::size_t k = 0; k < walls.size(); ++k)
-      if (walls.distanceTo(k, p.x[i]) < p.radius[i] + skin_) ++wc;
-    wall_start[i + 1] = wc;
+  // One pass over the stencil in fixed blocks of rows, each into its own buffer, then the buffers
+  // joined in block order: the same list for any number of threads.
+  constexpr long kRowsPerBlock = 256;
+  const long blocks = (n + kRowsPerBlock - 1) / kRowsPerBlock;
+  std::vector<std::vector<Index>> blockPairs(static_cast<std::size_t>(blocks)), blockWalls(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(dynamic, 1) if (n >= kDemParallelMinParticles)
+  for (long b = 0; b < blocks; ++b) {
+    auto& pairs = blockPairs[std::size_t(b)];
+    auto& wallsNear = blockWalls[std::size_t(b)];
+    for (long i = b * kRowsPerBlock; i < std::min(n, (b + 1) * kRowsPerBlock); ++i) {
+      const std::size_t first = pairs.size();
+      visit(i, [&](Index k) { pairs.push_back(k); });
+      // Sorted rows: a fixed order whatever the cell layout, and a cheap history look-up.
+      std::sort(pairs.begin() + std::ptrdiff_t(first), pairs.end());
+      row_start[i + 1] = static_cast<Index>(pairs.size() - first);
+      const std::size_t firstWall = wallsNear.size();
+      for (std::size_t k = 0; k < walls.size(); ++k)
+        if (walls.distanceTo(k, p.x[i]) < p.radius[i] + skin_) wallsNear.push_back(static_cast<Index>(k));
+      wall_start[i + 1] = static_cast<Index>(wallsNear.size() - firstWall);
+    }
   }
   for (long i = 0; i < n; ++i) {
     row_start[i + 1] += row_start[i];
@@ -156,13 +167,12 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
   j.resize(row_start[n]);
   shear.assign(row_start[n], Vector3d::Zero());
   wall_id.resize(wall_start[n]);
-#pragma omp parallel for schedule(dynamic, 256) if (n >= kDemParallelMinParticles)
-  for (long i = 0; i < n; ++i) {
-    Index pos = row_start[i];
-    visit(i, [&](Index k) { j[pos++] = k; });
-    // Sorted rows: a fixed order whatever the cell layout, and a cheap history look-up.
-    std::sort(j.begin() + row_start[i], j.begin() + row_start[i + 1]);
-    if (i < old_n) {
+#pragma omp parallel for schedule(dynamic, 1) if (n >= kDemParallelMinParticles)
+  for (long b = 0; b < blocks; ++b) {
+    const long i0 = b * kRowsPerBlock, i1 = std::min(n, (b + 1) * kRowsPerBlock);
+    std::copy(blockPairs[std::size_t(b)].begin(), blockPairs[std::size_t(b)].end(), j.begin() + row_start[i0]);
+    std::copy(blockWalls[std::size_t(b)].begin(), blockWalls[std::size_t(b)].end(), wall_id.begin() + wall_start[i0]);
+    for (long i = i0; i < std::min(i1, old_n); ++i) {
       Index o = old_start[i];
       const Index oe = old_start[i + 1];
       for (Index q = row_start[i]; q < row_start[i + 1]; ++q) {
@@ -170,9 +180,6 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
         if (o < oe && old_j[o] == j[q]) shear[q] = old_shear[o];
       }
     }
-    Index w = wall_start[i];
-    for (std::size_t k = 0; k < walls.size(); ++k)
-      if (walls.distanceTo(k, p.x[i]) < p.radius[i] + skin_) wall_id[w++] = static_cast<Index>(k);
   }
 
   // Transpose: counting sort of the pairs by their second member, in pair order.
