@@ -82,6 +82,7 @@ TEST(GasProCell, DivergenceBelowToleranceWithMovingAlpha) {
     g.setGasFraction(alpha);
     g.step(1.0);
     ASSERT_LE(g.lastStep().divergence.relative, c.scene.gas.pressure_tolerance) << "step " << step;
+    ASSERT_LE(g.lastStep().divergence.net, c.scene.gas.pressure_tolerance) << "step " << step;
     ASSERT_GT(std::abs(g.storageRate()), 1e-5) << "alpha_G does change";
     const double q = c.scene.process.gas_flow_rate;
     ASSERT_NEAR(g.netOutflow(), g.nozzleFlow() - g.storageRate(), 1e-7 * q) << "step " << step;

@@ -98,8 +98,9 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
     u_ = predicted;
     correct(diag);
     last_.divergence = divergence(dt);
-    if (last_.divergence.relative <= tol) break;
-    absTol *= 0.5 * tol / last_.divergence.relative;
+    const double worst = std::max(last_.divergence.relative, last_.divergence.net);
+    if (worst <= tol) break;
+    absTol *= 0.5 * tol / worst;
   }
   for (std::size_t c = 0; c < alpha_.size(); ++c) p_[c] = unknown_[c] >= 0 ? q_[unknown_[c]] * rho / dt : 0.0;
 }
@@ -194,11 +195,14 @@ DivergenceResidual GasSolver::divergence(double dt) const {
   const double area[3] = {h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};
   const double vol = grid_.cellVolume();
   std::vector<double> r(alpha_.size(), 0.0), scale(alpha_.size(), 0.0);
+  double supply = 0.0, stored = 0.0;  // gas fed (inlet, nozzle) and sum |storage| [m3/s]
   for (std::size_t c = 0; c < alpha_.size(); ++c) {
     if (!active_[c]) continue;
     const double storage = vol * phi_[c] * dAlphaDt_[c];
     r[c] = storage - vol * source_[c];
     scale[c] = std::abs(storage) + vol * std::abs(source_[c]);
+    supply += vol * std::abs(source_[c]);
+    stored += std::abs(storage);
   }
   for (int d = 0; d < 3; ++d) {
     const auto& s = ap_.shape[std::size_t(d)];
@@ -208,6 +212,7 @@ DivergenceResidual GasSolver::divergence(double dt) const {
           const std::size_t f = faceIndex(d, i, j, k);
           if (kind_[std::size_t(d)][f] == Closed) continue;
           const double flux = area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k) * u_[std::size_t(d)][f];
+          if (kind_[std::size_t(d)][f] == Inlet) supply += std::abs(flux);
           std::array<int, 3> lo{i, j, k};
           lo[std::size_t(d)] -= 1;
           if (lo[std::size_t(d)] >= 0) {
@@ -221,14 +226,18 @@ DivergenceResidual GasSolver::divergence(double dt) const {
         }
   }
   DivergenceResidual out;
-  double rr = 0.0, ss = 0.0;
+  double rr = 0.0, ss = 0.0, sum = 0.0;
   for (std::size_t c = 0; c < r.size(); ++c) {
     if (!active_[c]) continue;
+    sum += r[c];
     rr += r[c] * r[c];
     ss += scale[c] * scale[c];
     out.maxAbs = std::max(out.maxAbs, std::abs(r[c]) / vol);
   }
   out.relative = ss > 0 ? std::sqrt(rr / ss) : 0.0;
+  // Relative to the gas fed; without a feed (gas moved only by alpha_G), to what is stored.
+  const double netScale = supply > 0 ? supply : stored;
+  out.net = netScale > 0 ? std::abs(sum) / netScale : 0.0;
   return out;
 }
 

@@ -52,6 +52,10 @@ struct GasOptions {
 struct DivergenceResidual {
   double relative = 0.0;  ///< |r|_2 / |F|_2, F_c = sum_f |A a alpha u_f| + V|s_c| + V phi |dalpha/dt| [-]
   double maxAbs = 0.0;    ///< max_c |r_c| / V_c [1/s]
+  /// |sum_c r_c| / (inlet flow + nozzle flow): the domain's mass balance (what enters leaves or is
+  /// stored) relative to the gas fed (sum_c V phi |dalpha/dt| without a feed), which a small |r|_2 does
+  /// not bound tightly [-]
+  double net = 0.0;
 };
 
 struct GasStepStats {
