@@ -18,7 +18,6 @@ namespace rcfd::gas {
 // gives sum_f c_f (q_c - q_nb) = V s - V phi dalpha/dt - sum_f A a alpha u* . n_out with
 // c_f = A_f a_f alpha_f D_f / h (2 A a alpha / h at the outlet, where q = 0 half a cell away).
 void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& diag) {
-  const auto n = grid_.shape;
   const Eigen::Vector3d h = grid_.spacing;
   const double area[3] = {h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};
   const double vol = grid_.cellVolume();
@@ -39,35 +38,26 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
     b[r] += vol * source_[c] - storage;
     scale[r] += std::abs(vol * source_[c]) + std::abs(storage);
   }
-  for (int d = 0; d < 3; ++d) {
-    const auto& s = ap_.shape[std::size_t(d)];
-    for (int k = 0; k < s[2]; ++k)
-      for (int j = 0; j < s[1]; ++j)
-        for (int i = 0; i < s[0]; ++i) {
-          const std::size_t f = faceIndex(d, i, j, k);
-          const char kind = kind_[std::size_t(d)][f];
-          if (kind == Closed) continue;
-          const double aaa = area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k);
-          const double flux = aaa * u_[std::size_t(d)][f];  // along +d
-          std::array<int, 3> lo{i, j, k};
-          lo[std::size_t(d)] -= 1;
-          const int rLo = lo[std::size_t(d)] >= 0 ? unknown_[std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]))] : -1;
-          const int rHi = i < n[0] && j < n[1] && k < n[2] ? unknown_[std::size_t(grid_.flatIndex(i, j, k))] : -1;
-          if (rLo >= 0) b[rLo] -= flux, scale[rLo] += std::abs(flux);
-          if (rHi >= 0) b[rHi] += flux, scale[rHi] += std::abs(flux);
-          if (!rebuild) continue;
-          const auto& slot = matrixSlot_[std::size_t(d)][f];
-          if (kind == Interior) {
-            const double cf = aaa * diag[std::size_t(d)][f] / h[d];
-            values[slot[0]] += cf;
-            values[slot[1]] += cf;
-            values[slot[2]] -= cf;
-            values[slot[3]] -= cf;
-          } else if (kind == Outlet) {
-            values[slot[0]] += 2 * aaa / h[d];
-          }
-        }
-  }
+  forEachFace([&](int d, int i, int j, int k, std::size_t f) {
+    const char kind = kind_[std::size_t(d)][f];
+    if (kind == Closed) return;
+    const double aaa = area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k);
+    const double flux = aaa * u_[std::size_t(d)][f];  // along +d
+    const auto [rLo, rHi] = faceUnknowns(d, i, j, k);
+    if (rLo >= 0) b[rLo] -= flux, scale[rLo] += std::abs(flux);
+    if (rHi >= 0) b[rHi] += flux, scale[rHi] += std::abs(flux);
+    if (!rebuild) return;
+    const auto& slot = matrixSlot_[std::size_t(d)][f];
+    if (kind == Interior) {
+      const double cf = aaa * diag[std::size_t(d)][f] / h[d];
+      values[slot[0]] += cf;
+      values[slot[1]] += cf;
+      values[slot[2]] -= cf;
+      values[slot[3]] -= cf;
+    } else if (kind == Outlet) {
+      values[slot[0]] += 2 * aaa / h[d];
+    }
+  });
   if (rebuild) {
     const PressureSolver::Matrix& m = matrix_;
     // Unchanged values (alpha_G set again to the same field) keep the preconditioner.
@@ -109,35 +99,18 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
 // up once; each rebuild refills the values in place through the faces' slots, in the order the faces
 // are visited (the sums of the diagonal are those a triplet assembly would form).
 void GasSolver::buildMatrixPattern() {
-  const auto n = grid_.shape;
   const int unknowns = int(q_.size());
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(std::size_t(unknowns) * 7);
-  auto unknownsOf = [&](int d, int i, int j, int k) {
-    std::array<int, 3> lo{i, j, k};
-    lo[std::size_t(d)] -= 1;
-    const int rLo = lo[std::size_t(d)] >= 0 ? unknown_[std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]))] : -1;
-    const int rHi = i < n[0] && j < n[1] && k < n[2] ? unknown_[std::size_t(grid_.flatIndex(i, j, k))] : -1;
-    return std::array<int, 2>{rLo, rHi};
-  };
-  for (int d = 0; d < 3; ++d) {
-    const auto& s = ap_.shape[std::size_t(d)];
-    matrixSlot_[std::size_t(d)].assign(kind_[std::size_t(d)].size(), {0, 0, 0, 0});
-    for (int k = 0; k < s[2]; ++k)
-      for (int j = 0; j < s[1]; ++j)
-        for (int i = 0; i < s[0]; ++i) {
-          const char kind = kind_[std::size_t(d)][faceIndex(d, i, j, k)];
-          const auto [rLo, rHi] = unknownsOf(d, i, j, k);
-          if (kind == Interior) {
-            triplets.emplace_back(rLo, rLo, 1.0);
-            triplets.emplace_back(rHi, rHi, 1.0);
-            triplets.emplace_back(rLo, rHi, 1.0);
-            triplets.emplace_back(rHi, rLo, 1.0);
-          } else if (kind == Outlet) {
-            triplets.emplace_back(rLo, rLo, 1.0);
-          }
-        }
-  }
+  forEachFace([&](int d, int i, int j, int k, std::size_t f) {
+    const char kind = kind_[std::size_t(d)][f];
+    const auto [rLo, rHi] = faceUnknowns(d, i, j, k);
+    if (kind == Interior) {
+      for (const auto& [r, c] : {std::pair{rLo, rLo}, {rHi, rHi}, {rLo, rHi}, {rHi, rLo}}) triplets.emplace_back(r, c, 1.0);
+    } else if (kind == Outlet) {
+      triplets.emplace_back(rLo, rLo, 1.0);
+    }
+  });
   matrix_ = PressureSolver::Matrix(unknowns, unknowns);
   matrix_.setFromTriplets(triplets.begin(), triplets.end());
   matrix_.makeCompressed();
@@ -147,19 +120,23 @@ void GasSolver::buildMatrixPattern() {
     const int* end = inner + matrix_.outerIndexPtr()[row + 1];
     return int(std::lower_bound(begin, end, col) - inner);
   };
-  for (int d = 0; d < 3; ++d) {
-    const auto& s = ap_.shape[std::size_t(d)];
-    for (int k = 0; k < s[2]; ++k)
-      for (int j = 0; j < s[1]; ++j)
-        for (int i = 0; i < s[0]; ++i) {
-          const std::size_t f = faceIndex(d, i, j, k);
-          const char kind = kind_[std::size_t(d)][f];
-          const auto [rLo, rHi] = unknownsOf(d, i, j, k);
-          auto& slot = matrixSlot_[std::size_t(d)][f];
-          if (kind == Interior) slot = {slotOf(rLo, rLo), slotOf(rHi, rHi), slotOf(rLo, rHi), slotOf(rHi, rLo)};
-          else if (kind == Outlet) slot[0] = slotOf(rLo, rLo);
-        }
-  }
+  for (int d = 0; d < 3; ++d) matrixSlot_[std::size_t(d)].assign(kind_[std::size_t(d)].size(), {0, 0, 0, 0});
+  forEachFace([&](int d, int i, int j, int k, std::size_t f) {
+    const char kind = kind_[std::size_t(d)][f];
+    const auto [rLo, rHi] = faceUnknowns(d, i, j, k);
+    auto& slot = matrixSlot_[std::size_t(d)][f];
+    if (kind == Interior) slot = {slotOf(rLo, rLo), slotOf(rHi, rHi), slotOf(rLo, rHi), slotOf(rHi, rLo)};
+    else if (kind == Outlet) slot[0] = slotOf(rLo, rLo);
+  });
+}
+
+std::array<int, 2> GasSolver::faceUnknowns(int d, int i, int j, int k) const {
+  const auto n = grid_.shape;
+  std::array<int, 3> lo{i, j, k};
+  lo[std::size_t(d)] -= 1;
+  const int rLo = lo[std::size_t(d)] >= 0 ? unknown_[std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]))] : -1;
+  const int rHi = i < n[0] && j < n[1] && k < n[2] ? unknown_[std::size_t(grid_.flatIndex(i, j, k))] : -1;
+  return {rLo, rHi};
 }
 
 // Corrects the face velocities with the pressure gradient: u = u* - D (q_hi - q_lo) / h.

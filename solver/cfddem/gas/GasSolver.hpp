@@ -163,6 +163,19 @@ class GasSolver {
   void project(double dt, const std::array<std::vector<double>, 3>& diag);
   /// Sets up matrix_'s sparsity and the faces' slots in it (GasProjection.cpp).
   void buildMatrixPattern();
+  /// Pressure unknowns of the cells below (lo, along d) and above (hi) face (i, j, k) of axis d; -1
+  /// outside the grid or for an inactive cell.
+  std::array<int, 2> faceUnknowns(int d, int i, int j, int k) const;
+  /// Calls visit(d, i, j, k, face index) for every face of every axis, x fastest.
+  template <class Visit>
+  void forEachFace(Visit&& visit) const {
+    for (int d = 0; d < 3; ++d) {
+      const auto& s = ap_.shape[std::size_t(d)];
+      for (int k = 0; k < s[2]; ++k)
+        for (int j = 0; j < s[1]; ++j)
+          for (int i = 0; i < s[0]; ++i) visit(d, i, j, k, faceIndex(d, i, j, k));
+    }
+  }
   void correct(const std::array<std::vector<double>, 3>& diag);
   DivergenceResidual divergence(double dt) const;
   void checkAlpha(const std::vector<double>& alpha, const char* what) const;
