@@ -20,6 +20,30 @@ inline double limitedSlope(double forward, double backward) {
   return prod > 0.0 ? 2.0 * prod / (forward + backward) : 0.0;
 }
 
+/// Adds to r the advection and viscosity of one axis at a face, Eq. (2): -a dphi/dx by second-order
+/// upwind with a van Leer limiter (first order at extrema) from limited values at the two half-points,
+/// and nu d2phi/dx2; w0..w4 are the face values at offsets -2..2 along the axis, h its spacing. Both
+/// upwind sides are formed and one selected, so a loop over faces stays branch-free.
+inline double addAdvectionDiffusion(double r, double a, double w0, double w1, double w2, double w3, double w4,
+                                    double h, double nu) {
+  const double plusUp = w2 + 0.5 * limitedSlope(w3 - w2, w2 - w1);
+  const double minusUp = w1 + 0.5 * limitedSlope(w2 - w1, w1 - w0);
+  const double plusDown = w3 - 0.5 * limitedSlope(w4 - w3, w3 - w2);
+  const double minusDown = w2 - 0.5 * limitedSlope(w3 - w2, w2 - w1);
+  const bool up = a >= 0;
+  const double plus = up ? plusUp : plusDown, minus = up ? minusUp : minusDown;
+  r -= a * (plus - minus) / h;
+  r += nu * (w3 - 2 * w2 + w1) / (h * h);  // alpha grad.tau / (alpha rho)
+  return r;
+}
+
+/// Adds to r a face's body and source terms: gravity, the explicit force per volume fe over
+/// (alpha rho), and the nozzle air entering with the jet velocity (+y), s (u_jet - u) / alpha.
+inline double addSources(double r, double gravity, double fe, double sF, double jet, double u, double aF,
+                         double rho) {
+  return r + gravity + fe / (aF * rho) + sF * (jet - u) / aF;
+}
+
 /// Face loops below this size run serially (fork/join and barrier costs dominate).
 constexpr std::size_t kParallelFaces = 10000;
 
@@ -135,35 +159,21 @@ double GasSolver::faceRate(const std::array<std::vector<double>, 3>& u, int d, i
     for (int m = 0; m < 5; ++m) v[m] = g[m].sign * ud[std::size_t(std::ptrdiff_t(f) + g[m].shift * step)];
     if (!nearBaffle_[std::size_t(d)].empty() && (nearBaffle_[std::size_t(d)][f] >> e & 1u))
       mirrorAtBaffles(d, e, {i, j, k}, v);
-    // Second-order upwind with a van Leer limiter (first order at extrema): the advective derivative
-    // a dphi/dx from limited upwind values at the two half-points.
-    double plus, minus;
-    if (a >= 0) {
-      plus = v[2] + 0.5 * limitedSlope(v[3] - v[2], v[2] - v[1]);
-      minus = v[1] + 0.5 * limitedSlope(v[2] - v[1], v[1] - v[0]);
-    } else {
-      plus = v[3] - 0.5 * limitedSlope(v[4] - v[3], v[3] - v[2]);
-      minus = v[2] - 0.5 * limitedSlope(v[3] - v[2], v[2] - v[1]);
-    }
-    r -= a * (plus - minus) / h[e];
-    r += nu * (v[3] - 2 * v[2] + v[1]) / (h[e] * h[e]);  // alpha grad.tau / (alpha rho), Eq. (2)
+    r = addAdvectionDiffusion(r, a, v[0], v[1], v[2], v[3], v[4], h[e], nu);
   }
   const auto n = grid_.shape;
   const std::size_t ch = std::size_t(grid_.flatIndex(i, j, k));
   const std::size_t cl = ch - std::size_t(d == 0 ? 1 : d == 1 ? n[0] : std::ptrdiff_t(n[0]) * n[1]);
   const double aF = 0.5 * (alphaNext_[cl] + alphaNext_[ch]);
   const double fe = 0.5 * (fExplicit_[cl][d] + fExplicit_[ch][d]);
-  // Nozzle air enters with the jet velocity (+y): s (u_jet - u) / alpha, explicit.
   const double sF = 0.5 * (source_[cl] + source_[ch]);
-  const double jet = d == 1 ? nozzleJetVelocity_ : 0.0;
-  return r + options_.gravity[d] + fe / (aF * rho) + sF * (jet - ud[f]) / aF;
+  return addSources(r, options_.gravity[d], fe, sF, d == 1 ? nozzleJetVelocity_ : 0.0, ud[f], aF, rho);
 }
 
 void GasSolver::rowRates(const std::array<std::vector<double>, 3>& u, int d, int j, int k, int i0, int i1,
                          double* out) const {
-  // faceRate's arithmetic, in the same order, on faces i0 <= i < i1 of row (j, k) of axis d, whose
-  // stencils along x stay inside the grid and whose neighbours along d exist: branch-free, so the
-  // compiler vectorises it (the upwind side and the limiter are selects).
+  // faceRate on faces i0 <= i < i1 of row (j, k) of axis d, whose stencils along x stay inside the
+  // grid and whose neighbours along d exist: the same helpers in loops the compiler vectorises.
   constexpr int kChunk = 64;
   const Eigen::Vector3d hv = grid_.spacing;
   const double nu = scene_.gas.kinematic_viscosity, rho = scene_.gas.density;
@@ -204,21 +214,10 @@ void GasSolver::rowRates(const std::array<std::vector<double>, 3>& u, int d, int
       const double* v3 = ud + f0 + g[3].shift * dStride[e];
       const double* v4 = ud + f0 + g[4].shift * dStride[e];
       const double s0 = g[0].sign, s1 = g[1].sign, s2 = g[2].sign, s3 = g[3].sign, s4 = g[4].sign;
-      const double spacing = hv[e], spacing2 = hv[e] * hv[e];
+      const double spacing = hv[e];
 #pragma omp simd
-      for (int q = 0; q < m; ++q) {
-        const double w0 = s0 * v0[q], w1 = s1 * v1[q], w2 = s2 * v2[q], w3 = s3 * v3[q], w4 = s4 * v4[q];
-        const double plusUp = w2 + 0.5 * limitedSlope(w3 - w2, w2 - w1);
-        const double minusUp = w1 + 0.5 * limitedSlope(w2 - w1, w1 - w0);
-        const double plusDown = w3 - 0.5 * limitedSlope(w4 - w3, w3 - w2);
-        const double minusDown = w2 - 0.5 * limitedSlope(w3 - w2, w2 - w1);
-        const bool up = a[q] >= 0;
-        const double plus = up ? plusUp : plusDown, minus = up ? minusUp : minusDown;
-        double rq = r[q];
-        rq -= a[q] * (plus - minus) / spacing;
-        rq += nu * (w3 - 2 * w2 + w1) / spacing2;
-        r[q] = rq;
-      }
+      for (int q = 0; q < m; ++q)
+        r[q] = addAdvectionDiffusion(r[q], a[q], s0 * v0[q], s1 * v1[q], s2 * v2[q], s3 * v3[q], s4 * v4[q], spacing, nu);
     }
     const std::ptrdiff_t ch0 = (std::ptrdiff_t(k) * n[1] + j) * n[0] + c0, cl0 = ch0 - cellStride[d];
     const double* const fx = fExplicit_.data()->data();
@@ -228,7 +227,7 @@ void GasSolver::rowRates(const std::array<std::vector<double>, 3>& u, int d, int
       const double aF = 0.5 * (alphaNext_[std::size_t(cl)] + alphaNext_[std::size_t(ch)]);
       const double fe = 0.5 * (fx[3 * cl + d] + fx[3 * ch + d]);
       const double sF = 0.5 * (source_[std::size_t(cl)] + source_[std::size_t(ch)]);
-      const double rate = r[q] + gravity + fe / (aF * rho) + sF * (jet - ud[f0 + q]) / aF;
+      const double rate = addSources(r[q], gravity, fe, sF, jet, ud[f0 + q], aF, rho);
       out[f0 + q] = kinds[f0 + q] == Interior ? rate : 0.0;
     }
   }
