@@ -28,13 +28,14 @@ class AggregationMultigrid {
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   int levels() const { return int(levels_.size()); }
 
- private:
   /// A level's matrix split for Gauss-Seidel: the off-diagonal entries of each row in row order, and
   /// the diagonal (no search for it inside the sweep).
   struct SplitRows {
     std::vector<int> start, column;
     std::vector<double> value, diagonal;
   };
+
+ private:
   struct Level {
     Matrix a;
     std::vector<int> coarseOf;  ///< aggregate of each unknown on the next level
