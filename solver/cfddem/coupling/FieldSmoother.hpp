@@ -40,12 +40,15 @@ class FieldSmoother {
   const VolumeMapping& mapping_;
   double length_;
   int subSteps_ = 0;
-  /// Per axis d, per cell c: D dtau * conductance [m3] of the face between c - stride_d and c (0 when
-  /// closed or at the grid's low boundary). Structured sweeps: contiguous, vectorisable.
+  std::size_t cells_ = 0;
+  /// Zero cells before and after the grid in the padded layout: every +-stride neighbour of a cell is
+  /// inside the array, so the sweep needs no bounds tests.
+  std::size_t pad_ = 0;
+  /// Per axis d, in the padded layout, per cell c: D dtau * conductance [m3] of the face between
+  /// c - stride_d and c (0 when closed, at the grid's boundary or in the padding).
   std::array<std::vector<double>, 3> g_;
   std::array<std::size_t, 3> stride_{};
-  std::array<std::size_t, 3> first_{};  ///< first cell index with a face on the low side along d
-  std::vector<double> invVolume_;  ///< 1 / (V phi), 0 for unusable cells
+  std::vector<double> invVolume_;  ///< 1 / (V phi), 0 for unusable cells and the padding
 };
 
 }  // namespace rcfd::coupling
