@@ -60,7 +60,11 @@ nlohmann::json runCfdDem(const Options& o) {
   const double ramp = envOr("RCFD_BENCH_CFDDEM_RAMP", o.quick ? 0.02 : 0.1);
   const double seconds = envOr("RCFD_BENCH_CFDDEM_SECONDS", o.quick ? 0.02 : 0.2);
   CfdDemSimulation sim(scene, 1);
-  const auto cache = std::filesystem::temp_directory_path() / ("rcfd-bench-cfddem-" + scene.name + "-settled.h5");
+  // The grid is part of the key: a settled state carries the gas fields of its grid.
+  const auto& shape = sim.grid().shape;
+  const auto cache = std::filesystem::temp_directory_path() /
+                     ("rcfd-bench-cfddem-" + scene.name + "-" + std::to_string(shape[0]) + "x" +
+                      std::to_string(shape[1]) + "x" + std::to_string(shape[2]) + "-settled.h5");
   const char* startPath = std::getenv("RCFD_BENCH_CFDDEM_START");
   if (startPath) {
     // A developed state (saved by an earlier run with RCFD_BENCH_CFDDEM_SAVE) replaces fill and ramp.
