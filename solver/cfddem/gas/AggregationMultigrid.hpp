@@ -4,7 +4,10 @@
 /// merges the 2x2x2 blocks of level l's cells (a piecewise-constant prolongation P), A_{l+1} = P^T A_l P
 /// (Galerkin, so cut cells and alpha_G come along without geometry), symmetric Gauss-Seidel smoothing
 /// (forward before, backward after: the cycle is a symmetric operator, as CG needs), a sparse Cholesky
-/// on the coarsest level.
+/// on the coarsest level. On the finest level of a large grid the sweeps are hybrid: y-slabs of cells
+/// are swept in parallel, each reading the other slabs' values from before the sweep (Jacobi between
+/// slabs, Gauss-Seidel inside); the slabs are fixed by the grid, so the result is the same for any
+/// number of threads.
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -28,11 +31,14 @@ class AggregationMultigrid {
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
   int levels() const { return int(levels_.size()); }
 
-  /// A level's matrix split for Gauss-Seidel: the off-diagonal entries of each row in row order, and
-  /// the diagonal (no search for it inside the sweep).
+  /// A level's matrix split for Gauss-Seidel: the off-diagonal entries of each row, those of its own
+  /// block first (up to `own[r]`), then those of other blocks, and the diagonal (no search for it
+  /// inside the sweep). `blockRows` lists the rows of each block in row order; a single block is
+  /// classical Gauss-Seidel.
   struct SplitRows {
-    std::vector<int> start, column;
+    std::vector<int> start, own, column;
     std::vector<double> value, diagonal;
+    std::vector<std::vector<int>> blockRows;
   };
 
  private:
