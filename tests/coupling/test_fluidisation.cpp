@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -50,6 +51,13 @@ double bedSolidFraction(const DemParticles& p, double area, double y0, double y1
   return v / (area * (y1 - y0));
 }
 
+/// One defluidisation run: U_mf from the fitted packed branch, and what it is compared with.
+struct FluidisationRun {
+  double uMf = 0.0;       ///< [m/s]
+  double wenYu = 0.0;     ///< Wen-Yu's U_mf for these particles [m/s]
+  double ergunUmf = 0.0;  ///< Ergun's U_mf at the defluidised bed's own porosity [m/s]
+};
+
 // A 5 cm x 5 cm box (14 parcel diameters), cg 2 parcels of 3.6 mm in 5 mm cells as in quick.json, a
 // bed of 1570 parcels poured and settled (DEM only, as in the database job), about 2.6 cm high. The
 // gas rises to 0.9 m/s (1.6 Wen-Yu) in 0.2 s, stays 0.15 s (the bed slugs), and falls to 0.2 m/s in
@@ -57,8 +65,8 @@ double bedSolidFraction(const DemParticles& p, double area, double y0, double y1
 // part of the decreasing curve after the pressure drop last exceeded 0.9 W/A and below 0.75 W/A.
 // RCFD_FLUID_CSV=FILE writes the (t, U, dp) series; RCFD_FLUID_* change the protocol (see envOr).
 // U_mf = 1.14-1.19 Wen-Yu over seeds and rates (docs/physics.md "Minimum fluidisation"); 16-19 s on one
-// core. The slugging bed is chaotic: a rounding-level change of the run moves the ratio by ~0.02.
-TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
+// core per bed.
+void measureFluidisation(std::uint64_t seed, FluidisationRun& run) {
   const double width = envOr("RCFD_FLUID_WIDTH", 0.05);
   const double uHigh = envOr("RCFD_FLUID_UHIGH", 0.9), uLow = envOr("RCFD_FLUID_ULOW", 0.2);
   const double upTime = envOr("RCFD_FLUID_UP", 0.2), holdTime = envOr("RCFD_FLUID_HOLD", 0.15);
@@ -74,7 +82,7 @@ TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
   s.effects = {"gas", "drag", "rolling_friction"};
   gas::GasOptions go;
   go.boxBottomInlet = true;
-  CfdDemSimulation sim(s, std::uint64_t(envOr("RCFD_FLUID_SEED", 5)), go);
+  CfdDemSimulation sim(s, seed, go);
   sim.setFlowFactor(0.0);
   sim.fillAndSettle();
   const DemParticles& p = sim.dem().particles();
@@ -153,11 +161,30 @@ TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
             << " b " << fit.b << " (Ergun at eps " << eps << ": a " << ergunA << " b " << ergunB << ") rms "
             << fit.rms << " Pa; packing poured " << pouredPacking << " defluidised " << defluidisedPacking
              << "; U_mf " << uMf << " m/s, Ergun at eps " << ergunUmf << " m/s, Wen-Yu " << wenYu << " m/s, ratio " << uMf / wenYu << "\n";
-  RecordProperty("umf_over_wen_yu", std::to_string(uMf / wenYu));
-  EXPECT_NEAR(uMf, wenYu, 0.2 * wenYu) << "Wen-Yu " << wenYu << " m/s";
   // What is left of the difference to Wen-Yu is the bed's porosity: Ergun's U_mf at the porosity of
   // this bed's interior (0.42-0.44 here, Wen-Yu's constants correspond to about 0.40) is the fitted one.
-  EXPECT_NEAR(uMf, ergunUmf, 0.1 * ergunUmf) << "Ergun at eps " << eps;
+  EXPECT_NEAR(uMf, ergunUmf, 0.1 * ergunUmf) << "seed " << seed << ": Ergun at eps " << eps;
+  run = {uMf, wenYu, ergunUmf};
+}
+
+// The slugging bed is chaotic: a rounding-level change of the run (an operation reordered, the DEM's
+// neighbour-list skin) moves one bed's ratio by ~0.02-0.04, as much as another poured bed does. The
+// criterion is therefore the mean over three poured beds (seeds 5, 1, 2; RCFD_FLUID_SEED runs one).
+TEST(Fluidisation, MinimumFluidisationVelocityWithinTwentyPercentOfWenYu) {
+  std::vector<std::uint64_t> seeds = {5, 1, 2};
+  if (const char* one = std::getenv("RCFD_FLUID_SEED")) seeds = {std::uint64_t(std::atoll(one))};
+  double sum = 0.0, wenYu = 0.0;
+  for (const std::uint64_t seed : seeds) {
+    FluidisationRun run;
+    measureFluidisation(seed, run);
+    if (HasFatalFailure()) return;
+    std::cerr << "seed " << seed << ": U_mf / Wen-Yu " << run.uMf / run.wenYu << "\n";
+    sum += run.uMf;
+    wenYu = run.wenYu;
+  }
+  const double mean = sum / double(seeds.size());
+  RecordProperty("umf_over_wen_yu", std::to_string(mean / wenYu));
+  EXPECT_NEAR(mean, wenYu, 0.2 * wenYu) << "mean U_mf of " << seeds.size() << " beds; Wen-Yu " << wenYu << " m/s";
 }
 
 }  // namespace
