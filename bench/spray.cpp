@@ -4,6 +4,9 @@
 // The parcels are first brought to their steady airborne population (untimed), then both
 // configurations are timed over the same steps. Figures: simulated seconds per wall second, the
 // projected wall time of 1 h of process, and the spray stage's cost relative to the tracer step.
+// RCFD_BENCH_INTEGRATOR=euler|midpoint overrides the scene's integrator (an accuracy knob, as in
+// `rcfd-bench tracers`).
+#include <cstdlib>
 #include <iostream>
 
 #include "TracerBenchCase.hpp"
@@ -21,6 +24,7 @@ nlohmann::json runSpray(const Options& options) {
   // bring the airborne population to its steady level.
   const int warmup = options.quick ? 20 : 60;
   const int steps = options.quick ? 5 : 40;
+  if (const char* e = std::getenv("RCFD_BENCH_INTEGRATOR")) scene.rcfd.integrator = e;
 
   scene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
   const Timing tracers = timeRun(scene, bench.db, warmup, steps);
@@ -63,6 +67,7 @@ nlohmann::json runSpray(const Options& options) {
           {"deposited_fraction_so_far", injected > 0.0 ? deposited / injected : 0.0},
           {"overspray_fraction_so_far", injected > 0.0 ? overspray / injected : 0.0},
           {"tracers", scene.rcfd.tracers},
+          {"integrator", scene.rcfd.integrator},
           {"cells", bench.cells},
           {"dt", dt},
           {"tracer_stage_ms_per_step", tracers.stageMsPerStep},
