@@ -70,9 +70,9 @@ void gatherSweeps(std::array<double*, K> field, std::array<double*, K> spare, co
   const double* gy = g[1];
   const double* gz = g[2];
   // Gather form: each cell adds the fluxes through its six faces, each flux written with the same
-  // operands in the same order as in the neighbour that loses it, so the pair cancels exactly and
-  // the sum V phi gamma is conserved to round-off. A cell writes only itself: any split over threads
-  // gives the same bits.
+  // operands in the same order as in the neighbour that loses it (the two see one value with opposite
+  // signs), so the sum V phi gamma is conserved to round-off. A cell writes only itself: any split
+  // over threads gives the same bits. Reads into the padding meet zero conductances.
 #pragma omp parallel if (parallel)
   {
     std::array<double*, K> a = field, b = spare;
@@ -107,8 +107,14 @@ void FieldSmoother::smoothImpl(std::vector<T>& gamma) const {
   // Components to planes of their own: the sweep then reads contiguous doubles (vectorised).
   thread_local std::vector<double> planes;
   const std::size_t padded = cells_ + 2 * pad_;
-  // K planes and K spares. Only their interiors are ever written, so the padding stays 0.
-  if (planes.size() != 2 * K * padded) planes.assign(2 * K * padded, 0.0);
+  // K planes and K spares, their padding zeroed on every call: the scratch is shared by every
+  // smoother of this thread, and another grid's interior may have covered this one's padding.
+  planes.resize(2 * K * padded);
+  for (int q = 0; q < 2 * K; ++q) {
+    double* plane = planes.data() + std::size_t(q) * padded;
+    std::fill(plane, plane + pad_, 0.0);
+    std::fill(plane + pad_ + cells_, plane + padded, 0.0);
+  }
   std::array<double*, K> field, spare;
   for (int q = 0; q < K; ++q) {
     field[std::size_t(q)] = planes.data() + std::size_t(q) * padded;
