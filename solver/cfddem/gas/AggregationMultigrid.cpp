@@ -21,10 +21,9 @@ constexpr int kCoarsestUnknowns = 400;
 /// 3D ProCell 27 -> 10 (1.6 gave 7 and 12, 2.0 gave 7 in the slice).
 constexpr double kCoarseCorrectionScale = 1.8;
 
-/// Levels with at least this many unknowns are smoothed by hybrid Gauss-Seidel on kSmootherBlocks
-/// y-slabs (the quick slice's 24,000 and the 3D case's 74,000 finest unknowns; their coarser levels
-/// stay classical).
-constexpr int kHybridSmootherRows = 16384;
+/// A finest level of at least kParallelPressureRows unknowns is smoothed by hybrid Gauss-Seidel on
+/// this many y-slabs (the quick slice's 24,000 and the 3D case's 74,000 finest unknowns; the coarser
+/// levels stay classical).
 constexpr int kSmootherBlocks = 8;
 
 /// One Gauss-Seidel half sweep (forward or backward) of every block: within a block the usual
@@ -125,7 +124,7 @@ void AggregationMultigrid::compute(const Matrix& a) {
     const int n = int(levels_[l].a.rows());
     std::vector<int> blockOf(std::size_t(n), 0);
     int blocks = 1;
-    if (l == 0 && n >= kHybridSmootherRows) {
+    if (l == 0 && n >= kParallelPressureRows) {
       // y-slabs of equal height: the tall axis of a spouted bed, and every slab holds whole x-z planes.
       int yMax = 0;
       for (const auto& c : cellOf_) yMax = std::max(yMax, c[1]);

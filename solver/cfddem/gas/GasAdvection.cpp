@@ -44,9 +44,6 @@ inline double addSources(double r, double gravity, double fe, double sF, double 
   return r + gravity + fe / (aF * rho) + sF * (jet - u) / aF;
 }
 
-/// Face loops below this size run serially (fork/join and barrier costs dominate).
-constexpr std::size_t kParallelFaces = 10000;
-
 }  // namespace
 
 void GasSolver::buildStencils() {

@@ -145,7 +145,7 @@ void GasSolver::correct(const std::array<std::vector<double>, 3>& diag) {
   for (int d = 0; d < 3; ++d) {
     const auto& s = ap_.shape[std::size_t(d)];
     auto& ud = u_[std::size_t(d)];
-#pragma omp parallel for collapse(2) schedule(static) if (ud.size() > 10000)
+#pragma omp parallel for collapse(2) schedule(static) if (ud.size() > kParallelFaces)
     for (int k = 0; k < s[2]; ++k)
       for (int j = 0; j < s[1]; ++j)
         for (int i = 0; i < s[0]; ++i) {

@@ -272,7 +272,7 @@ double GasSolver::convectiveRate() const {
   const auto n = grid_.shape;
   double rate = 0.0;
   // A maximum: the same for any order of the cells, so for any number of threads.
-#pragma omp parallel for collapse(2) reduction(max : rate) schedule(static) if (alpha_.size() > 10000)
+#pragma omp parallel for collapse(2) reduction(max : rate) schedule(static) if (alpha_.size() > kParallelFaces)
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
@@ -313,7 +313,7 @@ double GasSolver::step(double maxDt) {
     auto& ud = u_[std::size_t(d)];
     diag[std::size_t(d)].assign(ud.size(), 1.0);
     // Each face is its own update (as in correct()): any split over threads gives the same bits.
-#pragma omp parallel for collapse(2) schedule(static) if (ud.size() > 10000)
+#pragma omp parallel for collapse(2) schedule(static) if (ud.size() > kParallelFaces)
     for (int k = 0; k < s[2]; ++k)
       for (int j = 0; j < s[1]; ++j)
         for (int i = 0; i < s[0]; ++i) {

@@ -31,6 +31,10 @@ class File;
 
 namespace rcfd::gas {
 
+/// Face (and cell) loops of the gas step below this size run serially: fork/join and barrier costs
+/// dominate. Every such loop writes each face or cell once, so the split never changes the bits.
+inline constexpr std::size_t kParallelFaces = 10000;
+
 /// Settings that are not in the scene (solver choices and verification set-ups).
 struct GasOptions {
   std::string preconditioner = "mg";  ///< "mg" (aggregation multigrid), "ic" (incomplete Cholesky) or "jacobi"

@@ -63,20 +63,13 @@ void PressureSolver::applyPreconditioner(const Eigen::VectorXd& r, Eigen::Vector
 
 namespace {
 
-/// Below this many rows the OpenMP fork/join costs more than the loop (and, on a loaded machine, a
-/// descheduled thread stalls every barrier of every CG iteration). 16,384, the multigrid's threshold
-/// for its parallel smoother: with that smoother in parallel the quick slice's 24,000 rows gained
-/// (2 threads, 0.03 s from a spouting state, 3 alternating runs: 3.60 -> 3.46 s with the parallel
-/// multigrid residual, 3.38 s with these loops too; at 150,000 before).
-constexpr long kParallelRows = 16384;
-
 /// y = A x with the rows split over the OpenMP threads (Eigen runs sparse products serially).
 void multiply(const PressureSolver::Matrix& a, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   const int n = int(a.rows());
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* val = a.valuePtr();
-#pragma omp parallel for schedule(static) if (n > kParallelRows)
+#pragma omp parallel for schedule(static) if (n >= kParallelPressureRows)
   for (int r = 0; r < n; ++r) {
     double s = 0.0;
     for (int q = outer[r]; q < outer[r + 1]; ++q) s += val[q] * x[inner[q]];
@@ -92,7 +85,7 @@ double dot(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const long n = a.size();
   const long blocks = (n + kDotBlock - 1) / kDotBlock;
   std::vector<double> partial(std::size_t(std::max(blocks, 1L)), 0.0);
-#pragma omp parallel for schedule(static) if (n > kParallelRows)
+#pragma omp parallel for schedule(static) if (n >= kParallelPressureRows)
   for (long k = 0; k < blocks; ++k) {
     double s = 0.0;
     const long end = std::min(n, (k + 1) * kDotBlock);
