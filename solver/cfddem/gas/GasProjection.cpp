@@ -19,7 +19,6 @@ namespace rcfd::gas {
 // c_f = A_f a_f alpha_f D_f / h (2 A a alpha / h at the outlet, where q = 0 half a cell away).
 void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& diag) {
   const Eigen::Vector3d h = grid_.spacing;
-  const double area[3] = {h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};
   const double vol = grid_.cellVolume();
   const int unknowns = int(q_.size());
   Eigen::VectorXd b = Eigen::VectorXd::Zero(unknowns), scale = Eigen::VectorXd::Zero(unknowns);
@@ -30,34 +29,53 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
     if (matrix_.rows() != unknowns) buildMatrixPattern();
     std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   }
+  computeGasAreas();
   double* const values = matrix_.valuePtr();
-  for (std::size_t c = 0; c < alpha_.size(); ++c) {
-    const int r = unknown_[c];
-    if (r < 0) continue;
-    const double storage = vol * phi_[c] * dAlphaDt_[c];
-    b[r] += vol * source_[c] - storage;
-    scale[r] += std::abs(vol * source_[c]) + std::abs(storage);
-  }
-  forEachFace([&](int d, int i, int j, int k, std::size_t f) {
-    const char kind = kind_[std::size_t(d)][f];
-    if (kind == Closed) return;
-    const double aaa = area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k);
-    const double flux = aaa * u_[std::size_t(d)][f];  // along +d
-    const auto [rLo, rHi] = faceUnknowns(d, i, j, k);
-    if (rLo >= 0) b[rLo] -= flux, scale[rLo] += std::abs(flux);
-    if (rHi >= 0) b[rHi] += flux, scale[rHi] += std::abs(flux);
-    if (!rebuild) return;
-    const auto& slot = matrixSlot_[std::size_t(d)][f];
-    if (kind == Interior) {
-      const double cf = aaa * diag[std::size_t(d)][f] / h[d];
-      values[slot[0]] += cf;
-      values[slot[1]] += cf;
-      values[slot[2]] -= cf;
-      values[slot[3]] -= cf;
-    } else if (kind == Outlet) {
-      values[slot[0]] += 2 * aaa / h[d];
-    }
-  });
+  // Each cell gathers its own row (b, scale and the matrix's row) from its faces, in the order a scatter
+  // over the faces (axis by axis, x fastest) would add them: the same sums for any number of threads.
+  // A face's lower cell subtracts its flux, its upper cell adds it.
+  const auto n = grid_.shape;
+#pragma omp parallel for collapse(2) schedule(static) if (alpha_.size() > kParallelFaces)
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        const std::size_t c = std::size_t(grid_.flatIndex(i, j, k));
+        const int r = unknown_[c];
+        if (r < 0) continue;
+        const double storage = vol * phi_[c] * dAlphaDt_[c];
+        double bc = 0.0 + (vol * source_[c] - storage);
+        double sc = 0.0 + (std::abs(vol * source_[c]) + std::abs(storage));
+        for (int d = 0; d < 3; ++d) {
+          int hiFace[3] = {i, j, k};
+          ++hiFace[d];
+          const std::size_t fLo = faceIndex(d, i, j, k), fHi = faceIndex(d, hiFace[0], hiFace[1], hiFace[2]);
+          const auto& kinds = kind_[std::size_t(d)];
+          const double* const gasArea = gasArea_[std::size_t(d)].data();
+          const double* const u = u_[std::size_t(d)].data();
+          const auto& slots = matrixSlot_[std::size_t(d)];
+          if (kinds[fLo] != Closed) {  // this cell is the face's upper cell
+            const double flux = gasArea[fLo] * u[fLo];
+            bc += flux, sc += std::abs(flux);
+            if (rebuild && kinds[fLo] == Interior) {
+              const double cf = gasArea[fLo] * diag[std::size_t(d)][fLo] / h[d];
+              values[slots[fLo][1]] += cf;
+              values[slots[fLo][3]] -= cf;
+            }
+          }
+          if (kinds[fHi] != Closed) {  // this cell is the face's lower cell
+            const double flux = gasArea[fHi] * u[fHi];
+            bc -= flux, sc += std::abs(flux);
+            if (rebuild && kinds[fHi] == Interior) {
+              const double cf = gasArea[fHi] * diag[std::size_t(d)][fHi] / h[d];
+              values[slots[fHi][0]] += cf;
+              values[slots[fHi][2]] -= cf;
+            } else if (rebuild && kinds[fHi] == Outlet) {
+              values[slots[fHi][0]] += 2 * gasArea[fHi] / h[d];
+            }
+          }
+        }
+        b[r] = bc, scale[r] = sc;
+      }
   if (rebuild) {
     const PressureSolver::Matrix& m = matrix_;
     // Unchanged values (alpha_G set again to the same field) keep the preconditioner.
@@ -87,12 +105,13 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
                      " of the flux scale, tolerance /gas/pressure_tolerance = " + std::to_string(tol) + ")");
     u_ = predicted;
     correct(diag);
-    last_.divergence = divergence(dt);
+    last_.divergence = divergence();
     const double worst = std::max(last_.divergence.relative, last_.divergence.net);
     if (worst <= tol) break;
     absTol *= 0.5 * tol / worst;
   }
   for (std::size_t c = 0; c < alpha_.size(); ++c) p_[c] = unknown_[c] >= 0 ? q_[unknown_[c]] * rho / dt : 0.0;
+  updatePressureGradient();
 }
 
 // The matrix's sparsity follows the topology alone (which faces are interior or outlet), so it is set
@@ -165,43 +184,66 @@ void GasSolver::correct(const std::array<std::vector<double>, 3>& diag) {
   }
 }
 
-DivergenceResidual GasSolver::divergence(double dt) const {
-  (void)dt;
-  const auto n = grid_.shape;
+void GasSolver::computeGasAreas() {
   const Eigen::Vector3d h = grid_.spacing;
   const double area[3] = {h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};
-  const double vol = grid_.cellVolume();
-  std::vector<double> r(alpha_.size(), 0.0), scale(alpha_.size(), 0.0);
-  double supply = 0.0, stored = 0.0;  // gas fed (inlet, nozzle) and sum |storage| [m3/s]
-  for (std::size_t c = 0; c < alpha_.size(); ++c) {
-    if (!active_[c]) continue;
-    const double storage = vol * phi_[c] * dAlphaDt_[c];
-    r[c] = storage - vol * source_[c];
-    scale[c] = std::abs(storage) + vol * std::abs(source_[c]);
-    supply += vol * std::abs(source_[c]);
-    stored += std::abs(storage);
-  }
+  inletFaces_.clear();
   for (int d = 0; d < 3; ++d) {
     const auto& s = ap_.shape[std::size_t(d)];
+    auto& out = gasArea_[std::size_t(d)];
+    out.resize(kind_[std::size_t(d)].size());
+#pragma omp parallel for collapse(2) schedule(static) if (out.size() > kParallelFaces)
     for (int k = 0; k < s[2]; ++k)
       for (int j = 0; j < s[1]; ++j)
         for (int i = 0; i < s[0]; ++i) {
           const std::size_t f = faceIndex(d, i, j, k);
-          if (kind_[std::size_t(d)][f] == Closed) continue;
-          const double flux = area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k) * u_[std::size_t(d)][f];
-          if (kind_[std::size_t(d)][f] == Inlet) supply += std::abs(flux);
-          std::array<int, 3> lo{i, j, k};
-          lo[std::size_t(d)] -= 1;
-          if (lo[std::size_t(d)] >= 0) {
-            const std::size_t c = std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]));
-            r[c] += flux, scale[c] += std::abs(flux);
+          out[f] = kind_[std::size_t(d)][f] == Closed ? 0.0 : area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k);
+        }
+    for (std::size_t f = 0; f < out.size(); ++f)
+      if (kind_[std::size_t(d)][f] == Inlet) inletFaces_.push_back({d, f});
+  }
+}
+
+DivergenceResidual GasSolver::divergence() const {
+  const auto n = grid_.shape;
+  const double vol = grid_.cellVolume();
+  std::vector<double>& r = divergenceScratch_[0];
+  std::vector<double>& scale = divergenceScratch_[1];
+  r.assign(alpha_.size(), 0.0), scale.assign(alpha_.size(), 0.0);
+  // Gathered per cell in the order of a scatter over the faces (as the assembly in project()): a face's
+  // lower cell gains its flux, its upper cell loses it.
+#pragma omp parallel for collapse(2) schedule(static) if (alpha_.size() > kParallelFaces)
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        const std::size_t c = std::size_t(grid_.flatIndex(i, j, k));
+        if (!active_[c]) continue;
+        const double storage = vol * phi_[c] * dAlphaDt_[c];
+        double rc = 0.0 + (storage - vol * source_[c]);
+        double sc = 0.0 + (std::abs(storage) + vol * std::abs(source_[c]));
+        for (int d = 0; d < 3; ++d) {
+          int hiFace[3] = {i, j, k};
+          ++hiFace[d];
+          const std::size_t fLo = faceIndex(d, i, j, k), fHi = faceIndex(d, hiFace[0], hiFace[1], hiFace[2]);
+          const auto& kinds = kind_[std::size_t(d)];
+          if (kinds[fLo] != Closed) {
+            const double flux = gasArea_[std::size_t(d)][fLo] * u_[std::size_t(d)][fLo];
+            rc -= flux, sc += std::abs(flux);
           }
-          if (i < n[0] && j < n[1] && k < n[2]) {
-            const std::size_t c = std::size_t(grid_.flatIndex(i, j, k));
-            r[c] -= flux, scale[c] += std::abs(flux);
+          if (kinds[fHi] != Closed) {
+            const double flux = gasArea_[std::size_t(d)][fHi] * u_[std::size_t(d)][fHi];
+            rc += flux, sc += std::abs(flux);
           }
         }
+        r[c] = rc, scale[c] = sc;
+      }
+  double supply = 0.0, stored = 0.0;  // gas fed (inlet, nozzle) and sum |storage| [m3/s]
+  for (std::size_t c = 0; c < alpha_.size(); ++c) {
+    if (!active_[c]) continue;
+    supply += vol * std::abs(source_[c]);
+    stored += std::abs(vol * phi_[c] * dAlphaDt_[c]);
   }
+  for (const auto& [d, f] : inletFaces_) supply += std::abs(gasArea_[std::size_t(d)][f] * u_[std::size_t(d)][f]);
   DivergenceResidual out;
   double rr = 0.0, ss = 0.0, sum = 0.0;
   for (std::size_t c = 0; c < r.size(); ++c) {

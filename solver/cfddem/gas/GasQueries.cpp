@@ -64,21 +64,38 @@ Eigen::Vector3d GasSolver::velocityAt(const Eigen::Vector3d& p) const {
   return u;
 }
 
-Eigen::Vector3d GasSolver::pressureGradientAt(const Eigen::Vector3d& p) const {
-  Eigen::Vector3d g;
-  const auto n = grid_.shape;
+void GasSolver::updatePressureGradient() {
   for (int d = 0; d < 3; ++d) {
     const double h = grid_.spacing[d];
+    const auto& s = ap_.shape[std::size_t(d)];
     const auto& kinds = kind_[std::size_t(d)];
-    g[d] = interpolate(ap_.shape[std::size_t(d)], grid_, d, p, true, [&](std::size_t f, const int* idx, double& v) {
+    auto& out = pressureGradient_[std::size_t(d)];
+    out.assign(kinds.size(), 0.0);
+#pragma omp parallel for collapse(2) schedule(static) if (out.size() > kParallelFaces)
+    for (int k = 0; k < s[2]; ++k)
+      for (int j = 0; j < s[1]; ++j)
+        for (int i = 0; i < s[0]; ++i) {
+          const std::size_t f = faceIndex(d, i, j, k);
+          const char kind = kinds[f];
+          if (kind != Interior && kind != Outlet) continue;
+          int lo[3] = {i, j, k};
+          lo[d] -= 1;
+          const double pLo = p_[std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]))];
+          if (kind == Interior) out[f] = (p_[std::size_t(grid_.flatIndex(i, j, k))] - pLo) / h;
+          else out[f] = (0.0 - pLo) / (0.5 * h);  // the outlet's p = 0 half a cell away
+        }
+  }
+}
+
+Eigen::Vector3d GasSolver::pressureGradientAt(const Eigen::Vector3d& p) const {
+  Eigen::Vector3d g;
+  for (int d = 0; d < 3; ++d) {
+    const auto& kinds = kind_[std::size_t(d)];
+    const auto& gradient = pressureGradient_[std::size_t(d)];
+    g[d] = interpolate(ap_.shape[std::size_t(d)], grid_, d, p, true, [&](std::size_t f, const int*, double& v) {
       const char kind = kinds[f];
       if (kind != Interior && kind != Outlet) return false;
-      int lo[3] = {idx[0], idx[1], idx[2]};
-      lo[d] -= 1;
-      const double pLo = p_[std::size_t(grid_.flatIndex(lo[0], lo[1], lo[2]))];
-      if (kind == Interior) v = (p_[std::size_t(grid_.flatIndex(idx[0], idx[1], idx[2]))] - pLo) / h;
-      else v = (0.0 - pLo) / (0.5 * h);
-      (void)n;
+      v = gradient[f];
       return true;
     });
   }

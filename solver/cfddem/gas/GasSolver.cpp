@@ -50,6 +50,7 @@ GasSolver::GasSolver(const Scene& scene, const Apparatus& apparatus, const Carte
   buildTopology();
   buildStencils();
   buildNozzle();
+  updatePressureGradient();
   source0_ = source_;
   inletVelocity0_ = inletVelocity_;
   nozzleJetVelocity0_ = nozzleJetVelocity_;

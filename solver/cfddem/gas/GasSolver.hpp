@@ -181,7 +181,12 @@ class GasSolver {
     }
   }
   void correct(const std::array<std::vector<double>, 3>& diag);
-  DivergenceResidual divergence(double dt) const;
+  /// pressureGradient_ from p_ (after every change of p_).
+  void updatePressureGradient();
+  /// gasArea_ and inletFaces_ for the alpha_G of the step being projected.
+  void computeGasAreas();
+  /// The continuity residual of Eq. (1) with the current face velocities and gasArea_.
+  DivergenceResidual divergence() const;
   void checkAlpha(const std::vector<double>& alpha, const char* what) const;
 
   const Scene& scene_;
@@ -207,6 +212,9 @@ class GasSolver {
   double nozzleJetVelocity0_ = 0.0, inletVelocity0_ = 0.0;
   double flowFactor_ = 1.0;
   std::vector<double> p_;
+  /// grad p on the interior and outlet faces of each axis [Pa/m] (0 on the others): computed once per
+  /// pressure solve, then interpolated at every parcel by pressureGradientAt().
+  std::array<std::vector<double>, 3> pressureGradient_;
   Eigen::VectorXd q_;             ///< p dt / rho of the last solve (warm start)
   std::unique_ptr<PressureSolver> pressureSolver_;
   PressureSolver::Matrix matrix_;  ///< the pressure matrix: pattern fixed by the topology, values refilled
@@ -221,6 +229,11 @@ class GasSolver {
   };
   std::array<std::array<std::vector<GhostPoint>, 3>, 3> ghost_;  ///< [d][e][x * 5 + m + 2]
   std::array<std::vector<std::uint8_t>, 3> nearBaffle_;          ///< [d][face]: bit e, empty without baffles
+  /// Per axis and face, its gas area A a alpha_G [m2] (0 where closed): computed once per projection
+  /// (alpha_G does not change within it) for the assembly and every divergence check.
+  std::array<std::vector<double>, 3> gasArea_;
+  std::vector<std::pair<int, std::size_t>> inletFaces_;  ///< (axis, face) of the inlet faces, in face order
+  mutable std::array<std::vector<double>, 2> divergenceScratch_;  ///< residual and scale per cell
   GasStepStats last_;
   double time_ = 0.0;
   double lastDt_ = 0.0;

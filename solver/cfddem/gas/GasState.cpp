@@ -50,6 +50,7 @@ void GasSolver::loadState(const h5::File& file, const std::string& group) {
   const std::size_t cells = alpha_.size();
   for (int d = 0; d < 3; ++d) u_[std::size_t(d)] = readSized("u" + std::to_string(d), u_[std::size_t(d)].size());
   p_ = readSized("p", cells);
+  updatePressureGradient();
   const std::vector<double> q = readSized("q", std::size_t(q_.size()));
   q_ = Eigen::Map<const Eigen::VectorXd>(q.data(), Eigen::Index(q.size()));
   alpha_ = readSized("alpha", cells);
