@@ -21,8 +21,10 @@ namespace rcfd::gas {
 /// multigrid level's (hybrid) smoothing, residual and prolongation, and the CG's products (below it the
 /// OpenMP fork/join costs more than the loop). Measured on the quick slice's 24,000 rows, 2 threads,
 /// 0.03 s from a spouting state (3 alternating runs): 3.60 -> 3.46 s with the parallel multigrid
-/// residual, 3.38 s with the CG's loops too; the threshold was 150,000 before.
-inline constexpr long kParallelPressureRows = 16384;
+/// residual, 3.38 s with the CG's loops too; the threshold was 150,000 before. 16,384 left the quick
+/// slice on 6.67 mm cells (8,832 unknowns) serial: 4,096 gave 3.73/3.77/4.12 s against 3.96/3.86/4.68 s
+/// per 0.05 s (3 alternating runs, the same 8.43 CG iterations per solve).
+inline constexpr long kParallelPressureRows = 4096;
 
 class AggregationMultigrid {
  public:
