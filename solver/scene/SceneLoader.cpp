@@ -112,17 +112,35 @@ JobSpec loadJob(const json& document, const std::string& source, const std::stri
   job.d0_values = document.value("d0_values", job.d0_values);
   job.discard = document.value("discard", job.discard);
 
+  // A /scene_patch (RFC 7396 merge patch) changes the scene for this job only; the patched scene is
+  // validated as a whole, and its errors name the scene's pointers and where the scene came from.
+  const json* patch = document.contains("scene_patch") ? &document["scene_patch"] : nullptr;
   if (document.contains("scene")) {
     const json& inline_scene = document["scene"];
-    job.scene = convertScene(inline_scene, violations);
-    violations = prefixed(std::move(violations), "/scene");
-    job.scene.source_json = inline_scene.dump(2);
+    if (patch) {
+      json patched = inline_scene;
+      patched.merge_patch(*patch);
+      try {
+        job.scene = loadScene(patched, source);
+      } catch (const InputError& e) {
+        throw InputError(source + " (/scene with /scene_patch applied)", prefixed(e.violations(), "/scene"));
+      }
+    } else {
+      job.scene = convertScene(inline_scene, violations);
+      violations = prefixed(std::move(violations), "/scene");
+      job.scene.source_json = inline_scene.dump(2);
+    }
   } else {
     std::filesystem::path file = document["scene_file"].get<std::string>();
     if (file.is_relative()) file = std::filesystem::path(baseDirectory) / file;
     std::ifstream probe(file);
     if (!probe) {
       violations.push_back({"/scene_file", "cannot read scene file \"" + file.string() + "\": " + std::strerror(errno)});
+    } else if (patch) {
+      json patched = parseText(readFile(file.string()), file.string(), "a scene");
+      requireObject(patched, file.string(), "a scene");
+      patched.merge_patch(*patch);
+      job.scene = loadScene(patched, file.string() + " with the /scene_patch of " + source);
     } else {
       job.scene = loadSceneFile(file.string());  // its own errors name the scene file and its pointers
     }

@@ -90,6 +90,49 @@ TEST(Jobs, InvalidJobsAreRefusedWithPointers) {
   EXPECT_EQ(refusedPointers({{"kind", "database"}, {"scene", bad}}), V{"/scene/spray/spray_zone/y_min"});
 }
 
+TEST(Jobs, ScenePatchChangesTheSceneOfThisJobOnly) {
+  const json patch = {{"dem", {{"sample_duration", 10.0}, {"reference_duration", 10.0}}}, {"name", "quick-10s"}};
+  // On a scene file, resolved relative to the job (the example job's own layout).
+  const JobSpec fromFile = loadJob({{"kind", "database"}, {"scene_file", "../quick.json"}, {"scene_patch", patch}}, "job",
+                                   sourcePath("examples/jobs"));
+  EXPECT_EQ(fromFile.scene.name, "quick-10s");
+  EXPECT_DOUBLE_EQ(fromFile.scene.dem.sample_duration, 10.0);
+  EXPECT_DOUBLE_EQ(fromFile.scene.dem.reference_duration, 10.0);
+  EXPECT_DOUBLE_EQ(fromFile.scene.dem.warmup, 1.0);  // untouched keys stay the file's
+  EXPECT_EQ(fromFile.scene.rcfd.tracers, 20000);
+  // The scene a result records is the patched one.
+  EXPECT_DOUBLE_EQ(json::parse(fromFile.scene.source_json)["dem"]["sample_duration"].get<double>(), 10.0);
+  // Inline, and null removes a key (merge-patch semantics): the default applies again.
+  const JobSpec inlined = loadJob({{"kind", "database"}, {"scene", quickScene()},
+                                   {"scene_patch", {{"dem", {{"sample_duration", nullptr}}}}}});
+  EXPECT_DOUBLE_EQ(inlined.scene.dem.sample_duration, 10.0);  // the schema's default
+  EXPECT_FALSE(json::parse(inlined.scene.source_json)["dem"].contains("sample_duration"));
+  EXPECT_DOUBLE_EQ(loadJob({{"kind", "database"}, {"scene", quickScene()}}).scene.dem.sample_duration, 2.0);
+  // The quick database job at the length: quick.json with 10 s sampled + 10 s reference.
+  const JobSpec tenSeconds = loadJobFile(sourcePath("examples/jobs/quick-database-10s.json"));
+  EXPECT_EQ(tenSeconds.scene.name, "quick");
+  EXPECT_DOUBLE_EQ(tenSeconds.scene.dem.sample_duration, 10.0);
+  EXPECT_DOUBLE_EQ(tenSeconds.scene.dem.reference_duration, 10.0);
+}
+
+TEST(Jobs, ScenePatchThatBreaksTheSceneIsRefusedWithItsPointer) {
+  using V = std::vector<std::string>;
+  const json badValue = {{"dem", {{"sample_duration", -1.0}}}};
+  EXPECT_EQ(refusedPointers({{"kind", "database"}, {"scene", quickScene()}, {"scene_patch", badValue}}),
+            V{"/scene/dem/sample_duration"});
+  try {
+    loadJob({{"kind", "database"}, {"scene_file", "../quick.json"}, {"scene_patch", badValue}}, "job",
+            sourcePath("examples/jobs"));
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.violations().size(), 1u) << e.what();
+    EXPECT_EQ(e.violations()[0].pointer, "/dem/sample_duration");  // in the scene file, as without a patch
+    EXPECT_NE(std::string(e.what()).find("scene_patch"), std::string::npos) << e.what();
+  }
+  // The patch itself must be an object.
+  EXPECT_EQ(refusedPointers({{"kind", "database"}, {"scene", quickScene()}, {"scene_patch", 3}}), V{"/scene_patch"});
+}
+
 TEST(Jobs, SchemaTextsAreServed) {
   EXPECT_NE(schemaText("scene").find("\"effects\""), std::string::npos);
   EXPECT_NE(schemaText("job").find("\"scene_file\""), std::string::npos);
