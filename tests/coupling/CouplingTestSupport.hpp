@@ -20,7 +20,7 @@ inline Scene couplingBox(const Vec3& size, double cell, double flowRate) {
   return s;
 }
 
-/// The quick slice of examples/quick.json (prismatic bed, 0.02 m deep, 5 mm cells, cg 2).
+/// The quick slice of examples/quick.json (prismatic bed, 0.02 m deep, cg 2) on its former 5 mm cells.
 inline Scene quickSlice() {
   Scene s = quickSliceScene(false);
   s.process.bed_mass = 0.15;
