@@ -6,6 +6,9 @@
 // then write the moved positions. No walls, no Eq. (10), no sub-steps, no cells for the next step.
 // The moved positions go to a second array, so every step reads the same sorted cloud.
 // Against `rcfd-bench tracers`, it says how much of a step is the layout and how much everything else.
+// Two of the kernel's other parts can be added to the midpoint floor, each with the kernel's own
+// function: the Eq. (10) direction (the tracer's cell read, its cell's speed gathered,
+// counterUnitVector()) and the cells of the moved positions for the next step (CellIndexer::cellsOf()).
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -15,8 +18,11 @@
 #include "BenchRegistry.hpp"
 #include "TracerBenchCase.hpp"
 #include "tracers/BlockSampling.hpp"
+#include "tracers/CellIndex.hpp"
+#include "tracers/CounterRng.hpp"
 #include "tracers/FrameSampler.hpp"
 #include "tracers/StepField.hpp"
+#include "tracers/UnitVectors.hpp"
 
 namespace rcfd::bench {
 namespace {
@@ -31,23 +37,49 @@ struct FloorCase {
   double *outX, *outY, *outZ;
   std::int64_t n;
   double dt;
+  const std::int32_t* cell;     ///< the tracers' cells (as the kernel reads them from the last step)
+  const float* speed;           ///< |u_fluc| per cell [m/s]
+  const std::int32_t* ids;
+  std::int32_t* nextCell;       ///< the moved positions' cells
+  const CellIndexer* indexer;
 };
 
-/// One step of the floor: `samples` = 1 (Euler) or 2 (midpoint).
-void floorStep(const FloorCase& c, int samples) {
+/// Which of the kernel's parts beyond the samples a floor step adds.
+struct FloorParts {
+  bool fluctuation = false;  ///< Eq. (10): cell, speed, direction
+  bool nextCells = false;    ///< the moved positions' cells
+};
+
+/// One step of the floor: `samples` = 1 (Euler) or 2 (midpoint), plus `parts`.
+void floorStep(const FloorCase& c, int samples, FloorParts parts, const CounterRngPrefix& prefix) {
   const std::int64_t blocks = (c.n + kBlock - 1) / kBlock;
   constexpr std::int64_t kChunk = 16;  // blocks, as the motion kernel's dynamic chunks
-  static constexpr double kZero[kBlock] = {};
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t chunk = 0; chunk < (blocks + kChunk - 1) / kChunk; ++chunk) {
     block::BlockStencils s;
     alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];
     alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];
+    alignas(64) double ax[kBlock] = {}, ay[kBlock] = {}, az[kBlock] = {};
     for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
       const std::int64_t i0 = b * kBlock;
       const int m = int(std::min<std::int64_t>(kBlock, c.n - i0));
+      if (parts.fluctuation) {
+        // Plain locals, as in the kernel: the vectoriser does not look through members or references.
+        const CounterRngPrefix rng = prefix;
+        const float* const speedOf = c.speed;
+        const std::int32_t* const ids = c.ids + i0;
+        alignas(64) std::int32_t cellOf[kBlock];
+        for (int k = 0; k < m; ++k) cellOf[k] = c.cell[i0 + k];
+#pragma omp simd
+        for (int k = 0; k < m; ++k) {
+          const double speed = double(speedOf[cellOf[k]]);
+          double nx, ny, nz;
+          counterUnitVector(rng, std::uint64_t(ids[k]), nx, ny, nz);
+          ax[k] = speed * nx, ay[k] = speed * ny, az[k] = speed * nz;
+        }
+      }
       locateBlock(c.q, m, c.x + i0, c.y + i0, c.z + i0, s);
-      sampleBlock(c.field, c.corners, s, m, kZero, kZero, kZero, ux, uy, uz);
+      sampleBlock(c.field, c.corners, s, m, ax, ay, az, ux, uy, uz);
       if (samples == 2) {
         const double half = 0.5 * c.dt;
 #pragma omp simd
@@ -55,7 +87,7 @@ void floorStep(const FloorCase& c, int samples) {
           mx[k] = c.x[i0 + k] + half * ux[k], my[k] = c.y[i0 + k] + half * uy[k], mz[k] = c.z[i0 + k] + half * uz[k];
         }
         locateBlock(c.q, m, mx, my, mz, s);
-        sampleBlock(c.field, c.corners, s, m, kZero, kZero, kZero, ux, uy, uz);
+        sampleBlock(c.field, c.corners, s, m, ax, ay, az, ux, uy, uz);
       }
 #pragma omp simd
       for (int k = 0; k < m; ++k) {
@@ -63,6 +95,10 @@ void floorStep(const FloorCase& c, int samples) {
         c.outY[i0 + k] = c.y[i0 + k] + c.dt * uy[k];
         c.outZ[i0 + k] = c.z[i0 + k] + c.dt * uz[k];
       }
+    }
+    if (parts.nextCells) {  // as the kernel: per chunk, while the moved positions are in cache
+      const std::int64_t first = chunk * kChunk * kBlock, last = std::min(c.n, (chunk + 1) * kChunk * kBlock);
+      c.indexer->cellsOf(int(last - first), c.outX + first, c.outY + first, c.outZ + first, c.nextCell + first);
     }
   }
 }
@@ -83,29 +119,44 @@ nlohmann::json run(const Options& options) {
   field.build(sampler, false, true);
   const std::size_t count = std::size_t(n);
   std::vector<double> outX(count), outY(count), outZ(count);
+  // The tracers' cells and a speed of Eq. (10) in every cell (its value does not change the cost).
+  const CellIndexer indexer(grid);
+  std::vector<std::int32_t> cells(count), nextCells(count);
+  indexer.cellsOf(int(n), cloud.x.data(), cloud.y.data(), cloud.z.data(), cells.data());
+  const std::vector<float> speed(std::size_t(grid.cellCount()), 0.01f);
   FloorCase c{field.floats(), {}, sampler.locator().constants(), cloud.x.data(), cloud.y.data(), cloud.z.data(),
-              outX.data(), outY.data(), outZ.data(), n, bench.scene.rcfd.dt};
+              outX.data(), outY.data(), outZ.data(), n, bench.scene.rcfd.dt, cells.data(), speed.data(),
+              cloud.id.data(), nextCells.data(), &indexer};
   c.corners.set(sampler.locator().offsets32());
+  const CounterRngPrefix prefix(1, RngPurpose::Fluctuation, 7);
   const int steps = options.quick ? 10 : 100;
   nlohmann::json out;
   out["tracers"] = n;
   out["cells"] = bench.cells;
   out["steps"] = steps;
-  for (const int samples : {2, 1}) {
-    floorStep(c, samples);  // untimed: first touch of the output pages
+  struct Variant {
+    const char* name;
+    int samples;
+    FloorParts parts;
+  };
+  const Variant variants[] = {{"midpoint", 2, {}},
+                              {"euler", 1, {}},
+                              {"midpoint_fluctuation", 2, {true, false}},
+                              {"midpoint_next_cells", 2, {false, true}},
+                              {"midpoint_fluctuation_next_cells", 2, {true, true}}};
+  for (const Variant& v : variants) {
+    floorStep(c, v.samples, v.parts, prefix);  // untimed: first touch of the output pages
     const double cpu0 = processCpuSeconds();
     const auto t0 = std::chrono::steady_clock::now();
-    for (int k = 0; k < steps; ++k) floorStep(c, samples);
+    for (int k = 0; k < steps; ++k) floorStep(c, v.samples, v.parts, prefix);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / steps;
     const double cpu = (processCpuSeconds() - cpu0) / steps;
-    const std::string name = samples == 2 ? "midpoint" : "euler";
-    std::cerr << "floor, " << name << " (" << samples << " sample" << (samples == 2 ? "s" : "") << " per tracer-step): "
-              << wall * 1e3 << " ms/step, " << cpu * 1e3 << " CPU-ms/step, " << cpu / double(n) * 1e9
-              << " CPU ns per tracer-step\n";
-    out[name] = {{"ms_per_step", wall * 1e3},
-                 {"cpu_ms_per_step", cpu * 1e3},
-                 {"cpu_ns_per_tracer_step", cpu / double(n) * 1e9},
-                 {"tracer_steps_per_s", double(n) / wall}};
+    std::cerr << "floor, " << v.name << ": " << wall * 1e3 << " ms/step, " << cpu * 1e3 << " CPU-ms/step, "
+              << cpu / double(n) * 1e9 << " CPU ns per tracer-step\n";
+    out[v.name] = {{"ms_per_step", wall * 1e3},
+                   {"cpu_ms_per_step", cpu * 1e3},
+                   {"cpu_ns_per_tracer_step", cpu / double(n) * 1e9},
+                   {"tracer_steps_per_s", double(n) / wall}};
   }
   double checksum = 0.0;  // keeps the stores observable
   for (std::int64_t i = 0; i < n; i += 997) checksum += outX[std::size_t(i)] + outY[std::size_t(i)] + outZ[std::size_t(i)];
