@@ -45,35 +45,20 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
         const double storage = vol * phi_[c] * dAlphaDt_[c];
         double bc = 0.0 + (vol * source_[c] - storage);
         double sc = 0.0 + (std::abs(vol * source_[c]) + std::abs(storage));
-        for (int d = 0; d < 3; ++d) {
-          int hiFace[3] = {i, j, k};
-          ++hiFace[d];
-          const std::size_t fLo = faceIndex(d, i, j, k), fHi = faceIndex(d, hiFace[0], hiFace[1], hiFace[2]);
-          const auto& kinds = kind_[std::size_t(d)];
-          const double* const gasArea = gasArea_[std::size_t(d)].data();
-          const double* const u = u_[std::size_t(d)].data();
-          const auto& slots = matrixSlot_[std::size_t(d)];
-          if (kinds[fLo] != Closed) {  // this cell is the face's upper cell
-            const double flux = gasArea[fLo] * u[fLo];
-            bc += flux, sc += std::abs(flux);
-            if (rebuild && kinds[fLo] == Interior) {
-              const double cf = gasArea[fLo] * diag[std::size_t(d)][fLo] / h[d];
-              values[slots[fLo][1]] += cf;
-              values[slots[fLo][3]] -= cf;
-            }
+        forEachOpenFaceOf(i, j, k, [&](int d, std::size_t f, bool upperCell) {
+          const double flux = gasArea_[std::size_t(d)][f] * u_[std::size_t(d)][f];
+          bc += upperCell ? flux : -flux, sc += std::abs(flux);
+          if (!rebuild) return;
+          const char kind = kind_[std::size_t(d)][f];
+          const auto& slot = matrixSlot_[std::size_t(d)][f];
+          if (kind == Interior) {
+            const double cf = gasArea_[std::size_t(d)][f] * diag[std::size_t(d)][f] / h[d];
+            values[slot[upperCell ? 1 : 0]] += cf;  // (hi, hi) or (lo, lo)
+            values[slot[upperCell ? 3 : 2]] -= cf;  // (hi, lo) or (lo, hi)
+          } else if (kind == Outlet && !upperCell) {
+            values[slot[0]] += 2 * gasArea_[std::size_t(d)][f] / h[d];
           }
-          if (kinds[fHi] != Closed) {  // this cell is the face's lower cell
-            const double flux = gasArea[fHi] * u[fHi];
-            bc -= flux, sc += std::abs(flux);
-            if (rebuild && kinds[fHi] == Interior) {
-              const double cf = gasArea[fHi] * diag[std::size_t(d)][fHi] / h[d];
-              values[slots[fHi][0]] += cf;
-              values[slots[fHi][2]] -= cf;
-            } else if (rebuild && kinds[fHi] == Outlet) {
-              values[slots[fHi][0]] += 2 * gasArea[fHi] / h[d];
-            }
-          }
-        }
+        });
         b[r] = bc, scale[r] = sc;
       }
   if (rebuild) {
@@ -187,7 +172,6 @@ void GasSolver::correct(const std::array<std::vector<double>, 3>& diag) {
 void GasSolver::computeGasAreas() {
   const Eigen::Vector3d h = grid_.spacing;
   const double area[3] = {h.y() * h.z(), h.x() * h.z(), h.x() * h.y()};
-  inletFaces_.clear();
   for (int d = 0; d < 3; ++d) {
     const auto& s = ap_.shape[std::size_t(d)];
     auto& out = gasArea_[std::size_t(d)];
@@ -199,8 +183,6 @@ void GasSolver::computeGasAreas() {
           const std::size_t f = faceIndex(d, i, j, k);
           out[f] = kind_[std::size_t(d)][f] == Closed ? 0.0 : area[d] * ap_.open[std::size_t(d)][f] * faceAlpha(d, f, i, j, k);
         }
-    for (std::size_t f = 0; f < out.size(); ++f)
-      if (kind_[std::size_t(d)][f] == Inlet) inletFaces_.push_back({d, f});
   }
 }
 
@@ -221,20 +203,10 @@ DivergenceResidual GasSolver::divergence() const {
         const double storage = vol * phi_[c] * dAlphaDt_[c];
         double rc = 0.0 + (storage - vol * source_[c]);
         double sc = 0.0 + (std::abs(storage) + vol * std::abs(source_[c]));
-        for (int d = 0; d < 3; ++d) {
-          int hiFace[3] = {i, j, k};
-          ++hiFace[d];
-          const std::size_t fLo = faceIndex(d, i, j, k), fHi = faceIndex(d, hiFace[0], hiFace[1], hiFace[2]);
-          const auto& kinds = kind_[std::size_t(d)];
-          if (kinds[fLo] != Closed) {
-            const double flux = gasArea_[std::size_t(d)][fLo] * u_[std::size_t(d)][fLo];
-            rc -= flux, sc += std::abs(flux);
-          }
-          if (kinds[fHi] != Closed) {
-            const double flux = gasArea_[std::size_t(d)][fHi] * u_[std::size_t(d)][fHi];
-            rc += flux, sc += std::abs(flux);
-          }
-        }
+        forEachOpenFaceOf(i, j, k, [&](int d, std::size_t f, bool upperCell) {
+          const double flux = gasArea_[std::size_t(d)][f] * u_[std::size_t(d)][f];
+          rc += upperCell ? -flux : flux, sc += std::abs(flux);
+        });
         r[c] = rc, scale[c] = sc;
       }
   double supply = 0.0, stored = 0.0;  // gas fed (inlet, nozzle) and sum |storage| [m3/s]

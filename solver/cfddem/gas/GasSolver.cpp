@@ -149,6 +149,10 @@ void GasSolver::buildTopology() {
   inletVelocity_ = inletArea > 0 ? q / inletArea : 0.0;
   for (std::size_t f = 0; f < kind_[1].size(); ++f)
     if (kind_[1][f] == Inlet) u_[1][f] = inletVelocity_;
+  inletFaces_.clear();
+  for (int d = 0; d < 3; ++d)
+    for (std::size_t f = 0; f < kind_[std::size_t(d)].size(); ++f)
+      if (kind_[std::size_t(d)][f] == Inlet) inletFaces_.push_back({d, f});
 }
 
 void GasSolver::buildNozzle() {

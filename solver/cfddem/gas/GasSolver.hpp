@@ -180,10 +180,23 @@ class GasSolver {
           for (int i = 0; i < s[0]; ++i) visit(d, i, j, k, faceIndex(d, i, j, k));
     }
   }
+  /// Calls visit(d, face, upperCell) for the six faces of cell (i, j, k) that are not closed, axis by
+  /// axis, the lower face first: the order in which a scatter over all faces (forEachFace) reaches
+  /// them, so sums gathered per cell equal the scatter's. upperCell: the cell lies above the face.
+  template <class Visit>
+  void forEachOpenFaceOf(int i, int j, int k, Visit&& visit) const {
+    for (int d = 0; d < 3; ++d) {
+      int hi[3] = {i, j, k};
+      ++hi[d];
+      const std::size_t lower = faceIndex(d, i, j, k), upper = faceIndex(d, hi[0], hi[1], hi[2]);
+      if (kind_[std::size_t(d)][lower] != Closed) visit(d, lower, true);
+      if (kind_[std::size_t(d)][upper] != Closed) visit(d, upper, false);
+    }
+  }
   void correct(const std::array<std::vector<double>, 3>& diag);
   /// pressureGradient_ from p_ (after every change of p_).
   void updatePressureGradient();
-  /// gasArea_ and inletFaces_ for the alpha_G of the step being projected.
+  /// gasArea_ for the alpha_G of the step being projected.
   void computeGasAreas();
   /// The continuity residual of Eq. (1) with the current face velocities and gasArea_.
   DivergenceResidual divergence() const;
@@ -232,7 +245,7 @@ class GasSolver {
   /// Per axis and face, its gas area A a alpha_G [m2] (0 where closed): computed once per projection
   /// (alpha_G does not change within it) for the assembly and every divergence check.
   std::array<std::vector<double>, 3> gasArea_;
-  std::vector<std::pair<int, std::size_t>> inletFaces_;  ///< (axis, face) of the inlet faces, in face order
+  std::vector<std::pair<int, std::size_t>> inletFaces_;  ///< (axis, face) of the inlet faces, in face order (topology)
   mutable std::array<std::vector<double>, 2> divergenceScratch_;  ///< residual and scale per cell
   GasStepStats last_;
   double time_ = 0.0;
