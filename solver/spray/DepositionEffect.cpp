@@ -82,8 +82,11 @@ class DepositionEffect final : public TracerEffect {
       const Eigen::Vector3d p = pc.position(std::size_t(j));
       const auto cell = std::int32_t(ctx.grid.flatIndexOf(p));
       s.parcelCell[std::size_t(j)] = cell;
-      const DepositionInput in{ctx.tracerAlpha[std::size_t(cell)],
-                               (sampler.velocity(p, true) - sampler.velocity(p, false)).norm(), ctx.dt};
+      const double alphaP = ctx.tracerAlpha[std::size_t(cell)];
+      // No tracers, no deposition (eta = 0, Eq. 11): most airborne parcels are above the bed, and the
+      // two velocity samples are the dear part.
+      if (!(alphaP > 0.0)) continue;
+      const DepositionInput in{alphaP, (sampler.velocity(p, true) - sampler.velocity(p, false)).norm(), ctx.dt};
       s.parcelDeposit[std::size_t(j)] = pc.droplets[std::size_t(j)] * model_->efficiency(in, constants_);
     }
     std::fill(s.cellDeposit.begin(), s.cellDeposit.end(), 0.0);
