@@ -9,6 +9,8 @@
 
 #include "geometry/WallClearance.hpp"
 #include "spray/SprayState.hpp"
+#include "tracers/BlockSampling.hpp"
+#include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
@@ -134,37 +136,22 @@ class SprayEffect final : public TracerEffect {
     auto& pc = s.parcels;
     const std::int64_t n = std::int64_t(pc.size());
     if (n == 0) return;
-    std::vector<std::int8_t> exit(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
+    exit_.assign(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
     const FrameSampler frames = ctx.sampler();
-    // u_G^rec of the step as a 4-float step field, blended once per cell: a parcel sub-step then reads
-    // its corners like a tracer (float trilinear, block::interpolateCorners) instead of blending and
-    // converting 8 corners in double.
+    // u_G^rec of the step as a 4-float step field, blended once per cell: parcels read its corners with
+    // the tracer kernel's block functions (float trilinear, block::interpolateCorners) instead of
+    // blending and converting 8 corners in double per sub-step.
     gasField_.build(frames, true, ctx.grid.cellCount() > kParallelThreshold);
-    const StepFieldSampler sampler(gasField_, frames.locator());
-    const double dt = ctx.dt;
-#pragma omp parallel for schedule(dynamic, 64) if (n > kParallelThreshold)  // sub-steps vary: dynamic
-    for (std::int64_t j = 0; j < n; ++j) {
-      Eigen::Vector3d p = pc.position(std::size_t(j));
-      Eigen::Vector3d u = sampler.sample(p);
-      const double courant = u.norm() * dt / minSpacing_;
-      const int nsub = courant < 64.0 ? std::max(1, int(std::ceil(courant))) : 64;
-      const double h = dt / nsub;
-      for (int k = 0; k < nsub; ++k) {
-        if (k > 0) u = sampler.sample(p);
-        const Eigen::Vector3d end = p + h * u;
-        if (h * u.norm() < double(clearance_[std::size_t(ctx.grid.flatIndexOf(p))])) {
-          p = end;
-          continue;
-        }
-        if (const auto hit = ctx.apparatus.firstIntersection(p, end)) {
-          exit[std::size_t(j)] = hit->kind == BoundaryKind::Outlet ? 2 : 1;
-          p = hit->point;
-          break;
-        }
-        p = end;
-      }
-      pc.x[std::size_t(j)] = p.x(), pc.y[std::size_t(j)] = p.y(), pc.z[std::size_t(j)] = p.z();
+    BlockMove move{gasField_.floats(), frames.locator().constants(), {}, CellIndexer(ctx.grid), ctx.dt, minSpacing_};
+    move.corners.set(frames.locator().offsets32());
+    const std::int64_t blocks = (n + block::kBlock - 1) / block::kBlock;
+    // Blocks start at multiples of kBlock and parcels are independent: the same for any thread count.
+#pragma omp parallel for schedule(dynamic, 1) if (n > kParallelThreshold)  // sub-steps vary: dynamic
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      const std::int64_t j0 = b * block::kBlock;
+      moveBlock(ctx, move, pc, j0, int(std::min<std::int64_t>(block::kBlock, n - j0)));
     }
+    const std::vector<std::int8_t>& exit = exit_;
     // Serial, in parcel order: the books and the compaction are the same for any thread count.
     std::size_t keep = 0;
     for (std::size_t j = 0; j < std::size_t(n); ++j) {
@@ -180,6 +167,92 @@ class SprayEffect final : public TracerEffect {
     pc.x.resize(keep), pc.y.resize(keep), pc.z.resize(keep), pc.droplets.resize(keep), pc.id.resize(keep);
   }
 
+  /// What every block of parcels reads in a step.
+  struct BlockMove {
+    const float* field;                     ///< u_G^rec of the step, 4 floats per cell
+    TrilinearLocator::Constants locator;
+    block::CornerOffsets corners;
+    CellIndexer indexer;
+    double dt;
+    double spacing;                         ///< smallest cell spacing [m]
+  };
+
+  /// Lanes of a block of parcels still moving, compacted after every sub-step round.
+  struct ParcelLanes {
+    alignas(64) double x[block::kBlock], y[block::kBlock], z[block::kBlock];
+    alignas(64) double ux[block::kBlock], uy[block::kBlock], uz[block::kBlock];
+    alignas(64) double h[block::kBlock];
+    alignas(64) std::int32_t left[block::kBlock], cell[block::kBlock], parcel[block::kBlock];
+  };
+
+  /// u_G^rec at the first `count` lanes' positions.
+  static void sampleLanes(const BlockMove& bm, ParcelLanes& L, int count) {
+    alignas(64) static constexpr double kZero[block::kBlock] = {};
+    block::BlockStencils stencils;
+    block::locateBlock(bm.locator, count, L.x, L.y, L.z, stencils);
+    block::sampleBlock(bm.field, bm.corners, stencils, count, kZero, kZero, kZero, L.ux, L.uy, L.uz);
+  }
+
+  /// Parcels j0 .. j0 + count - 1 through the step: sub-steps so that none moves farther than one
+  /// cell at its start velocity (particle Courant number <= 1, at most 64), u_G^rec sampled at every
+  /// sub-step's start; a sub-step that may reach a boundary gets the exact segment test, and a hit
+  /// ends the parcel there (overspray). Rounds run on the lanes with sub-steps left, compacted.
+  void moveBlock(const TracerContext& ctx, const BlockMove& bm, ParcelCloud& pc, std::int64_t j0, int count) {
+    constexpr int kMaxParcelSubsteps = 64;
+    ParcelLanes L;
+    for (int k = 0; k < count; ++k) {
+      const std::size_t j = std::size_t(j0 + k);
+      L.x[k] = pc.x[j], L.y[k] = pc.y[j], L.z[k] = pc.z[j];
+      L.parcel[k] = k;
+    }
+    sampleLanes(bm, L, count);
+    for (int k = 0; k < count; ++k) {
+      const double courant = Eigen::Vector3d(L.ux[k], L.uy[k], L.uz[k]).norm() * bm.dt / bm.spacing;
+      const int nsub = courant < double(kMaxParcelSubsteps) ? std::max(1, int(std::ceil(courant)))
+                                                            : kMaxParcelSubsteps;  // also for NaN
+      L.h[k] = bm.dt / nsub;
+      L.left[k] = nsub;
+    }
+    const float* clearance = clearance_.data();
+    int active = count;
+    while (active > 0) {
+      bm.indexer.cellsOf(active, L.x, L.y, L.z, L.cell);
+      alignas(64) std::int32_t fast[block::kBlock];
+      // Moves shorter than their cell's clearance reach no boundary (compared squared: either answer
+      // near the bound is safe, the exact test finds no hit for a move clear of every boundary).
+#pragma omp simd
+      for (int k = 0; k < active; ++k) {
+        const double dx = L.h[k] * L.ux[k], dy = L.h[k] * L.uy[k], dz = L.h[k] * L.uz[k];
+        const double c = double(clearance[L.cell[k]]);
+        fast[k] = std::int32_t(dx * dx + dy * dy + dz * dz < c * c);
+      }
+      int kept = 0;
+      for (int k = 0; k < active; ++k) {
+        const Eigen::Vector3d p(L.x[k], L.y[k], L.z[k]);
+        const Eigen::Vector3d end = p + L.h[k] * Eigen::Vector3d(L.ux[k], L.uy[k], L.uz[k]);
+        Eigen::Vector3d at = end;
+        bool done = --L.left[k] == 0;
+        if (!fast[k]) {
+          if (const auto hit = ctx.apparatus.firstIntersection(p, end)) {
+            exit_[std::size_t(j0 + L.parcel[k])] = hit->kind == BoundaryKind::Outlet ? 2 : 1;
+            at = hit->point;
+            done = true;
+          }
+        }
+        if (done) {
+          const std::size_t j = std::size_t(j0 + L.parcel[k]);
+          pc.x[j] = at.x(), pc.y[j] = at.y(), pc.z[j] = at.z();
+          continue;
+        }
+        L.x[kept] = at.x(), L.y[kept] = at.y(), L.z[kept] = at.z();
+        L.h[kept] = L.h[k], L.left[kept] = L.left[k], L.parcel[kept] = L.parcel[k];
+        ++kept;
+      }
+      active = kept;
+      if (active > 0) sampleLanes(bm, L, active);
+    }
+  }
+
   SpraySpec spec_;
   std::shared_ptr<SprayState> state_;
   double cosHalfAngle_ = 1.0;
@@ -187,6 +260,7 @@ class SprayEffect final : public TracerEffect {
   double minSpacing_ = 1.0;
   std::vector<float> clearance_;  ///< per cell: moves shorter than this hit no boundary [m]
   StepVelocityField gasField_;    ///< u_G^rec of the step (rebuilt every step with parcels airborne)
+  std::vector<std::int8_t> exit_; ///< per parcel of the step: 0 airborne, 1 wall, 2 outlet
 };
 
 const bool registered = TracerEffectRegistry::add(
