@@ -89,14 +89,15 @@ class DepositionEffect final : public TracerEffect {
       const DepositionInput in{alphaP, (sampler.velocity(p, true) - sampler.velocity(p, false)).norm(), ctx.dt};
       s.parcelDeposit[std::size_t(j)] = pc.droplets[std::size_t(j)] * model_->efficiency(in, constants_);
     }
-    std::fill(s.cellDeposit.begin(), s.cellDeposit.end(), 0.0);
-    touched_.clear();
+    // Only the cells of the last step's deposits hold anything: zeroed one by one, not all 74k.
+    for (const std::int32_t c : s.depositCells) s.cellDeposit[std::size_t(c)] = 0.0;
+    s.depositCells.clear();
     std::size_t keep = 0;
     for (std::size_t j = 0; j < std::size_t(n); ++j) {
       const double dep = s.parcelDeposit[j];
       const auto c = std::size_t(s.parcelCell[j]);
       if (dep > 0.0) {
-        if (s.cellDeposit[c] == 0.0) touched_.push_back(std::int32_t(c));
+        if (s.cellDeposit[c] == 0.0) s.depositCells.push_back(std::int32_t(c));
         s.cellDeposit[c] += dep;
         s.balance.deposited += dep;
       }
@@ -110,6 +111,7 @@ class DepositionEffect final : public TracerEffect {
       ++keep;
     }
     pc.x.resize(keep), pc.y.resize(keep), pc.z.resize(keep), pc.droplets.resize(keep), pc.id.resize(keep);
+    touched_.assign(s.depositCells.begin(), s.depositCells.end());
     if (!pendingCellsKnown_) {  // first step of a run or of a resume: find cells keeping a fraction
       for (std::size_t c = 0; c < s.cellPending.size(); ++c) {
         if (s.cellPending[c] > 0.0) touched_.push_back(std::int32_t(c));

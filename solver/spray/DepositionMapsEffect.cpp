@@ -20,10 +20,9 @@ class DepositionMapsEffect final : public TracerEffect {
 
   void afterMove(TracerContext& ctx) override {
     if (!ctx.collecting()) return;
+    // cellDeposit is 0 outside depositCells: adding only those cells gives the same sums.
     const auto& dep = state_->cellDeposit;
-    const std::int64_t n = std::int64_t(sum_.size());
-#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
-    for (std::int64_t c = 0; c < n; ++c) sum_[std::size_t(c)] += dep[std::size_t(c)];
+    for (const std::int32_t c : state_->depositCells) sum_[std::size_t(c)] += dep[std::size_t(c)];
     ++samples_;
   }
 

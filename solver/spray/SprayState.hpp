@@ -41,6 +41,7 @@ struct SprayState {
 
   // Allocated by `deposition`:
   std::vector<double> cellDeposit;      ///< droplets stripped from parcels per cell in the current step
+  std::vector<std::int32_t> depositCells;  ///< the cells where cellDeposit > 0 (the rest is 0), in first-deposit order
   std::vector<double> cellPending;      ///< stripped droplets not yet handed to a tracer (< 1 per cell)
   double assigned = 0.0;                ///< droplets handed to tracers (whole droplets)
   std::vector<double> tracerDroplets;   ///< whole droplets collected by each tracer (all its particles)
