@@ -33,6 +33,8 @@ struct TracerBenchCase {
     const double cell = options.quick ? 0.015 : 0.0074;  // 0.0074 m -> about 74k cells
     scene.grid.cell_size = Vec3(cell, cell, cell);
     scene.rcfd.tracers = options.quick ? 47285 : 472850;
+    // The tracer count is an accuracy knob: RCFD_BENCH_TRACERS prices other counts on the same case.
+    if (const char* e = std::getenv("RCFD_BENCH_TRACERS")) scene.rcfd.tracers = std::atoll(e);
     scene.rcfd.d0 = 5e-4;
     Apparatus apparatus(scene.apparatus);
     const CartesianGrid grid = makeGrid(apparatus, scene.grid);

@@ -5,7 +5,8 @@
 // configurations are timed over the same steps. Figures: simulated seconds per wall second, the
 // projected wall time of 1 h of process, and the spray stage's cost relative to the tracer step.
 // RCFD_BENCH_INTEGRATOR=euler|midpoint overrides the scene's integrator (an accuracy knob, as in
-// `rcfd-bench tracers`).
+// `rcfd-bench tracers`); RCFD_BENCH_TRACERS the tracer count, RCFD_BENCH_STEPS the timed steps.
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 
@@ -22,8 +23,11 @@ nlohmann::json runSpray(const Options& options) {
   Scene& scene = bench.scene;
   // Parcels cross the apparatus in about 0.2 s (12 m/s in the spout, 2 m/s above it): 60 steps of 5 ms
   // bring the airborne population to its steady level.
+  // 100 timed steps: one period of the synthetic field and one interval of the tracers' sort by cell,
+  // sort included (until 2026-12-02: 40 steps, frames 60-99 and no sort). RCFD_BENCH_STEPS overrides.
   const int warmup = options.quick ? 20 : 60;
-  const int steps = options.quick ? 5 : 40;
+  int steps = options.quick ? 5 : 100;
+  if (const char* e = std::getenv("RCFD_BENCH_STEPS")) steps = std::max(1, std::atoi(e));
   if (const char* e = std::getenv("RCFD_BENCH_INTEGRATOR")) scene.rcfd.integrator = e;
 
   scene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
@@ -67,6 +71,7 @@ nlohmann::json runSpray(const Options& options) {
           {"deposited_fraction_so_far", injected > 0.0 ? deposited / injected : 0.0},
           {"overspray_fraction_so_far", injected > 0.0 ? overspray / injected : 0.0},
           {"tracers", scene.rcfd.tracers},
+          {"timed_steps", steps},
           {"integrator", scene.rcfd.integrator},
           {"cells", bench.cells},
           {"dt", dt},

@@ -22,6 +22,8 @@ struct Lanes {
   int count = 0;
   /// The cells of the positions (the step's first round: the tracers' cells), or null (later rounds)
   const std::int32_t* cell = nullptr;
+  /// With `cell`: each lane's MotionKernel::cellData_ reach, loaded with its Eq. (10) speed
+  const float* reach = nullptr;
 };
 
 /// Storage of compacted lanes.
@@ -32,9 +34,10 @@ struct LaneStorage {
   alignas(64) double h[kBlock];
   alignas(64) std::int32_t left[kBlock];
   alignas(64) std::int32_t cell[kBlock];
+  alignas(64) float reach[kBlock];
   std::int32_t lane[kBlock];  ///< the lane's index in the lanes it was compacted from
   Lanes view(int count, bool withCells = false) {
-    return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count, withCells ? cell : nullptr};
+    return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count, withCells ? cell : nullptr, withCells ? reach : nullptr};
   }
   /// Copies lane k of `from` (position, u_fluc, velocity, sub-step, sub-steps left) into lane j.
   void copyLane(const Lanes& from, int k, int j) {

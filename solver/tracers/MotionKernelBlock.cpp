@@ -52,6 +52,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   const double noWall = bc.noWall;
   std::int64_t pending = 0;
   const std::int32_t* startCell = L.cell;
+  const float* startReach = L.reach;
   const double halfDiagonal = bc.halfDiagonal;
 #pragma omp simd
   for (int k = 0; k < m; ++k) {
@@ -67,7 +68,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
       off[k] = halfDiagonal;
       cell[k] = startCell[k];
       // |disp| < reach - off, squared (no square root where most lanes are decided)
-      const double room = double(cellData[2 * cell[k]]) + noWall - off[k];
+      const double room = double(startReach[k]) + noWall - off[k];
       fast[k] = std::int64_t(room > 0.0) & std::int64_t(length2[k] < room * room);
       pending += 1 - fast[k];
     }
