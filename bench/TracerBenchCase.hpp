@@ -62,43 +62,80 @@ struct Timing {
   nlohmann::json stageMsPerStep = nlohmann::json::object();  ///< TracerSimulation::stageSeconds() per step [ms]
 };
 
+/// One benchmark simulation, stepped and timed one step at a time (so that two configurations can be
+/// timed in alternation, step by step: the VM's speed drifts by up to 30% within minutes, and drift
+/// then falls on both alike).
+class TimedRun {
+ public:
+  TimedRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup, int steps)
+      : tracers_(scene.rcfd.tracers), sim_(scene, db, pathFor(*db, warmup + steps), settingsFor(warmup + steps)) {
+    for (int k = 0; k < std::max(1, warmup); ++k) sim_.step();
+    sim_.resetStageSeconds();
+  }
+
+  /// One timed step.
+  void step() {
+    const double cpu0 = processCpuSeconds();
+    const auto t0 = std::chrono::steady_clock::now();
+    sim_.step();
+    wall_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cpu_ += processCpuSeconds() - cpu0;
+    ++steps_;
+    const MotionStatistics& m = sim_.motionStatistics();
+    sum_.substeps += m.substeps, sum_.wallHits += m.wallHits, sum_.scalarPath += m.scalarPath;
+    sum_.exactWallTests += m.exactWallTests, sum_.freeFlight += m.freeFlight;
+  }
+
+  /// The figures of the timed steps.
+  Timing timing() const {
+    Timing t;
+    const int steps = std::max(1, steps_);
+    t.secondsPerStep = wall_ / steps;
+    t.cpuSecondsPerStep = cpu_ / steps;
+    t.tracerStepsPerSecond = double(tracers_) / t.secondsPerStep;
+    const double tracerSteps = double(tracers_) * double(steps);
+    t.substepFraction = double(sum_.substeps) / tracerSteps;
+    t.wallHitFraction = double(sum_.wallHits) / tracerSteps;
+    t.scalarFraction = double(sum_.scalarPath) / tracerSteps;
+    t.wallTestFraction = double(sum_.exactWallTests) / tracerSteps;
+    t.freeFlightFraction = double(sum_.freeFlight) / tracerSteps;
+    for (const auto& [stage, seconds] : sim_.stageSeconds()) t.stageMsPerStep[stage] = seconds / steps * 1e3;
+    return t;
+  }
+
+  TracerSimulation& simulation() { return sim_; }
+
+ private:
+  static RecurrencePath pathFor(const FieldDatabase& db, int steps) {
+    RecurrencePath path;
+    for (int k = 0; k < steps + 2; ++k) path.frames.push_back(k % db.frameCount());
+    return path;
+  }
+  static TracerRunSettings settingsFor(int steps) {
+    // RCFD_BENCH_SCALAR_KERNEL=1: every tracer through the kernel's scalar path (what the block path saves).
+    const char* scalarOnly = std::getenv("RCFD_BENCH_SCALAR_KERNEL");
+    const bool vectorised = !(scalarOnly && std::string(scalarOnly) == "1");
+    // RCFD_BENCH_SORT_INTERVAL=N: tracers re-sorted by cell every N steps (0: never; default 100).
+    TracerRunSettings settings{1, steps, 0, vectorised};
+    if (const char* e = std::getenv("RCFD_BENCH_SORT_INTERVAL")) settings.sortInterval = std::atoll(e);
+    return settings;
+  }
+
+  long tracers_;
+  TracerSimulation sim_;
+  double wall_ = 0.0, cpu_ = 0.0;
+  int steps_ = 0;
+  MotionStatistics sum_;  // over the timed steps (the field's phases differ in how much sub-stepping they need)
+};
+
+/// Wall and CPU time of `steps` steps of one configuration after `warmup` untimed ones.
 template <class AfterRun = void (*)(TracerSimulation&)>
 Timing timeRun(const Scene& scene, std::shared_ptr<FieldDatabase> db, int warmup, int steps,
                AfterRun after = [](TracerSimulation&) {}) {
-  RecurrencePath path;
-  for (int k = 0; k < warmup + steps + 2; ++k) path.frames.push_back(k % db->frameCount());
-  // RCFD_BENCH_SCALAR_KERNEL=1: every tracer through the kernel's scalar path (what the block path saves).
-  const char* scalarOnly = std::getenv("RCFD_BENCH_SCALAR_KERNEL");
-  const bool vectorised = !(scalarOnly && std::string(scalarOnly) == "1");
-  // RCFD_BENCH_SORT_INTERVAL=N: tracers re-sorted by cell every N steps (0: never; default 100).
-  TracerRunSettings settings{1, warmup + steps, 0, vectorised};
-  if (const char* e = std::getenv("RCFD_BENCH_SORT_INTERVAL")) settings.sortInterval = std::atoll(e);
-  TracerSimulation sim(scene, db, path, settings);
-  for (int k = 0; k < std::max(1, warmup); ++k) sim.step();
-  sim.resetStageSeconds();
-  const double cpu0 = processCpuSeconds();
-  const auto t0 = std::chrono::steady_clock::now();
-  MotionStatistics sum;  // over the timed steps (the field's phases differ in how much sub-stepping they need)
-  for (int k = 0; k < steps; ++k) {
-    sim.step();
-    const MotionStatistics& m = sim.motionStatistics();
-    sum.substeps += m.substeps, sum.wallHits += m.wallHits, sum.scalarPath += m.scalarPath;
-    sum.exactWallTests += m.exactWallTests, sum.freeFlight += m.freeFlight;
-  }
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  Timing t;
-  t.secondsPerStep = s / steps;
-  t.cpuSecondsPerStep = (processCpuSeconds() - cpu0) / steps;
-  t.tracerStepsPerSecond = double(scene.rcfd.tracers) / t.secondsPerStep;
-  const double tracerSteps = double(scene.rcfd.tracers) * double(steps);
-  t.substepFraction = double(sum.substeps) / tracerSteps;
-  t.wallHitFraction = double(sum.wallHits) / tracerSteps;
-  t.scalarFraction = double(sum.scalarPath) / tracerSteps;
-  t.wallTestFraction = double(sum.exactWallTests) / tracerSteps;
-  t.freeFlightFraction = double(sum.freeFlight) / tracerSteps;
-  for (const auto& [stage, seconds] : sim.stageSeconds()) t.stageMsPerStep[stage] = seconds / steps * 1e3;
-  after(sim);
-  return t;
+  TimedRun run(scene, std::move(db), warmup, steps);
+  for (int k = 0; k < steps; ++k) run.step();
+  after(run.simulation());
+  return run.timing();
 }
 
 }  // namespace rcfd::bench
