@@ -224,7 +224,7 @@ class SprayEffect final : public TracerEffect {
       for (int k = 0; k < active; ++k) {
         const double dx = L.h[k] * L.ux[k], dy = L.h[k] * L.uy[k], dz = L.h[k] * L.uz[k];
         const double c = double(clearance[L.cell[k]]);
-        fast[k] = std::int32_t(dx * dx + dy * dy + dz * dz < c * c);
+        fast[k] = std::int32_t(c > 0.0) & std::int32_t(dx * dx + dy * dy + dz * dz < c * c);
       }
       int kept = 0;
       for (int k = 0; k < active; ++k) {
