@@ -37,7 +37,7 @@ class SprayEffect final : public TracerEffect {
   }
 
   std::size_t allocatedBytes() const override {
-    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + gasField_.bytes();
+    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + gasField_.bytes() + exit_.capacity();
   }
 
   void afterMove(TracerContext& ctx) override {
