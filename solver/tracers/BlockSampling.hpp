@@ -79,10 +79,9 @@ struct CornerOffsets {
   }
 };
 
-/// u = trilinear(field; stencil) + (ax, ay, az) for the lanes of a block located in `s`.
-inline void sampleBlock(const float* field, const CornerOffsets& co, const BlockStencils& s, int count,
-                        const double* ax, const double* ay, const double* az, double* ux, double* uy, double* uz) {
-  alignas(64) float u4[4 * kBlock];
+/// u4[4k .. 4k + 3] = (u_x, u_y, u_z, 0) = trilinear(field; stencil of lane k) for the lanes of a block
+/// located in `s`, in float.
+inline void sampleBlock4(const float* field, const CornerOffsets& co, const BlockStencils& s, int count, float* u4) {
 #ifdef RCFD_BLOCK_SAMPLING_AVX2
   if (co.adjacentX) {
     const std::int32_t o0 = co.off4[0], o2 = co.off4[2], o4 = co.off4[4], o6 = co.off4[6];
@@ -98,13 +97,19 @@ inline void sampleBlock(const float* field, const CornerOffsets& co, const Block
       const __m128 s0 = _mm256_castps256_ps128(s01), s1 = _mm256_extractf128_ps(s01, 1);
       _mm_store_ps(u4 + 4 * k, _mm_fmadd_ps(_mm_set1_ps(s.fx[k]), _mm_sub_ps(s1, s0), s0));
     }
-  } else
-#endif
-  {
-    for (int k = 0; k < count; ++k) {
-      interpolateCorners(field + 4 * std::int64_t(s.base[k]), co.off4, s.fx[k], s.fy[k], s.fz[k], u4 + 4 * k);
-    }
+    return;
   }
+#endif
+  for (int k = 0; k < count; ++k) {
+    interpolateCorners(field + 4 * std::int64_t(s.base[k]), co.off4, s.fx[k], s.fy[k], s.fz[k], u4 + 4 * k);
+  }
+}
+
+/// u = trilinear(field; stencil) + (ax, ay, az) for the lanes of a block located in `s`.
+inline void sampleBlock(const float* field, const CornerOffsets& co, const BlockStencils& s, int count,
+                        const double* ax, const double* ay, const double* az, double* ux, double* uy, double* uz) {
+  alignas(64) float u4[4 * kBlock];
+  sampleBlock4(field, co, s, count, u4);
 #pragma omp simd
   for (int k = 0; k < count; ++k) {
     ux[k] = double(u4[4 * k]) + ax[k];
