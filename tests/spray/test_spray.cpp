@@ -6,6 +6,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <utility>
 
 #include "spray/Coverage.hpp"
 #include "spray/SprayState.hpp"
@@ -45,6 +46,35 @@ TEST(Spray, MassBalanceClosesOverAHundredThousandSteps) {
   // Deposited droplets are on the tracers or waiting in their cell (less than one droplet per cell).
   const double onTracers = m["on_tracers_kg"].get<double>(), pending = m["pending_in_cells_kg"].get<double>();
   EXPECT_NEAR(onTracers + pending, m["deposited_kg"].get<double>(), 1e-9 * injected);
+}
+
+TEST(Spray, DepositionMapsIntegrateToTheDepositedMass) {
+  // Conservation of the maps: the time-averaged rate density [kg/(m3 s)], integrated over the open volume
+  // of every cell and the collecting time, is the deposited mass. Statistics start at step 500, so the
+  // deposits of the discarded steps must stay out of the maps.
+  Scene s = sprayBoxScene(400, 0.3, 0.08);
+  auto db = sprayBoxDatabase(s, 0.3, 0.08, 3.0);
+  const std::int64_t steps = 3000, discard = 500;
+  TracerSimulation sim(s, db, sequentialPath(db->frameCount(), steps + 2), {5, steps, discard});
+  for (std::int64_t k = 0; k < discard; ++k) sim.step();
+  const double depositedBefore = sim.context().spray->balance.deposited * sim.context().spray->dropletMass;
+  for (std::int64_t k = discard; k < steps; ++k) sim.step();
+  const std::string file = tempPath("maps.h5");
+  nlohmann::json summary;
+  {
+    h5::File out(file, h5::File::Mode::Create);
+    sim.writeResults(out, summary);
+  }
+  const double deposited = summary["mass_balance"]["deposited_kg"].get<double>() - depositedBefore;
+  ASSERT_GT(deposited, 0.0);
+  ASSERT_GT(depositedBefore, 0.0);
+  const auto rate = h5::File(file, h5::File::Mode::ReadOnly).readDoubles("/deposition_maps/rate_density");
+  const auto& open = std::as_const(sim).context().openVolume;
+  ASSERT_EQ(rate.size(), open.size());
+  double integral = 0.0;
+  for (std::size_t c = 0; c < rate.size(); ++c) integral += rate[c] * open[c];
+  integral *= double(steps - discard) * s.rcfd.dt;
+  EXPECT_NEAR(integral, deposited, 1e-9 * deposited);
 }
 
 TEST(Spray, EmptyBedIsAllOversprayAndNoCoverage) {
