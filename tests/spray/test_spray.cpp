@@ -77,6 +77,43 @@ TEST(Spray, DepositionMapsIntegrateToTheDepositedMass) {
   EXPECT_NEAR(integral, deposited, 1e-9 * deposited);
 }
 
+TEST(Spray, ParcelsRideAUniformUpdraftAndLeaveThroughTheOutlet) {
+  // u_G^rec = U straight up everywhere: a parcel injected in step s has been carried (N - 1 - s) steps
+  // of U dt each (sub-stepped: 1.5 cells per step), sideways not at all, and every parcel that left the
+  // box left through the top outlet, none through a wall.
+  constexpr double U = 3.0;
+  Scene s = sprayBoxScene(400, 0.3, 0.08);
+  s.effects = {"spray"};
+  const CartesianGrid grid = gridOf(s);
+  auto db = database(s, 6, s.rcfd.dt, [&](int, double, FieldFrame& f) {
+    for (std::int64_t c = 0; c < grid.cellCount(); ++c) f.u_g[3 * c + 1] = float(U);
+  });
+  const std::int64_t steps = 40;  // 0.6 m of travel: the first parcels left through the top (0.2 m)
+  TracerSimulation sim(s, db, sequentialPath(db->frameCount(), steps + 2), {7, steps, 0});
+  for (std::int64_t k = 0; k < steps; ++k) sim.step();
+  const SprayState& spray = *std::as_const(sim).context().spray;
+  const double perStep = s.spray.parcels_per_s * s.rcfd.dt;  // 10 parcels injected per step
+  // Injected on the nozzle within one cell of its head (SprayEffect::inject).
+  const double reach = 0.5 * s.spray.nozzle_diameter + grid.spacing.minCoeff();
+  ASSERT_GT(spray.parcels.size(), 100u);
+  for (std::size_t j = 0; j < spray.parcels.size(); ++j) {
+    const auto injectedAt = std::int64_t(double(spray.parcels.id[j]) / perStep);
+    const double carried = double(steps - 1 - injectedAt) * U * s.rcfd.dt;
+    const Eigen::Vector3d start = spray.parcels.position(j) - Eigen::Vector3d(0.0, carried, 0.0);
+    ASSERT_LE((start - s.spray.nozzle_position).norm(), reach + 1e-12) << "parcel " << spray.parcels.id[j];
+    ASSERT_LT(spray.parcels.y[j], s.apparatus.size.y());
+  }
+  const auto summary = results(sim, "updraft");
+  const auto& m = summary["mass_balance"];
+  EXPECT_GT(m["overspray_outlet_kg"].get<double>(), 0.0);
+  EXPECT_EQ(m["overspray_wall_kg"].get<double>(), 0.0);
+  EXPECT_LE(std::abs(closure(m)), 1e-12 * m["injected_kg"].get<double>());
+  // The airborne parcels are those injected in the last 0.2 m / (U dt) = 13.3 steps, give or take one.
+  const double airborneSteps = double(spray.parcels.size()) / perStep;
+  EXPECT_GE(airborneSteps, 12.0);
+  EXPECT_LE(airborneSteps, 15.0);
+}
+
 TEST(Spray, EmptyBedIsAllOversprayAndNoCoverage) {
   Scene s = sprayBoxScene(300, 0.0);
   s.process.bed_mass = 0.0;  // tracers carry no particles: alpha_P of the tracers is 0 everywhere
