@@ -151,13 +151,12 @@ class SprayEffect final : public TracerEffect {
       const std::int64_t j0 = b * block::kBlock;
       moveBlock(ctx, move, pc, j0, int(std::min<std::int64_t>(block::kBlock, n - j0)));
     }
-    const std::vector<std::int8_t>& exit = exit_;
     // Serial, in parcel order: the books and the compaction are the same for any thread count.
     std::size_t keep = 0;
     for (std::size_t j = 0; j < std::size_t(n); ++j) {
-      if (exit[j] == 1) s.balance.oversprayWall += pc.droplets[j];
-      if (exit[j] == 2) s.balance.oversprayOutlet += pc.droplets[j];
-      if (exit[j] != 0) continue;
+      if (exit_[j] == 1) s.balance.oversprayWall += pc.droplets[j];
+      if (exit_[j] == 2) s.balance.oversprayOutlet += pc.droplets[j];
+      if (exit_[j] != 0) continue;
       if (keep != j) {
         pc.x[keep] = pc.x[j], pc.y[keep] = pc.y[j], pc.z[keep] = pc.z[j];
         pc.droplets[keep] = pc.droplets[j], pc.id[keep] = pc.id[j];
