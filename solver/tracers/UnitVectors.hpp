@@ -1,9 +1,9 @@
 #pragma once
 /// \file UnitVectors.hpp
-/// Uniform random unit vectors from a counter-based stream in a form the compiler vectorises: float
-/// arithmetic, and sin and cos of the azimuth from polynomials (Cephes' minimax coefficients on
-/// [-pi/4, pi/4], error ~1 ulp) instead of libm's sincos, which does not vectorise. The motion kernel
-/// draws the Eq. (10) direction of a whole block of tracers at once with it.
+/// Uniform random unit vectors from a counter-based stream in a form the compiler vectorises: 32-bit
+/// integer hashes, float arithmetic, and sin and cos of the azimuth from polynomials (Cephes' minimax
+/// coefficients on [-pi/4, pi/4], error ~1 ulp) instead of libm's sincos, which does not vectorise.
+/// The motion kernel draws the Eq. (10) direction of a whole block of tracers at once with it.
 
 #include <cmath>
 #include <cstdint>
@@ -29,17 +29,43 @@ inline void sinCosTwoPiFloat(float u, float& s, float& c) {
   c = ((q + 1) & 2) ? -ca : ca;
 }
 
-/// The random unit vector of stream `stream` (uniform on the sphere) in float arithmetic: z and the
-/// azimuth from the upper and lower 24 bits of the draw CounterRng(prefix, stream).nextU64() gives
-/// first (CounterRng::unitVector() takes 32 bits of each, in double). The Eq. (10) direction of the
-/// motion kernel: its speed is a float per cell already, so a direction to float precision (|n| = 1
-/// within 3e-7) loses nothing, and float halves the vector work of the double form.
+/// Chris Wellons' `lowbias32` (hash-prospector): a bijective 32-bit integer hash with full avalanche
+/// (bias 0.17). 32-bit multiplications vectorise natively with AVX2; SplitMix64's 64-bit ones do not
+/// (AVX2 has no 64-bit multiply: three 32-bit ones and shifts each).
+constexpr std::uint32_t hash32(std::uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352dU;
+  x ^= x >> 15;
+  x *= 0x846ca68bU;
+  x ^= x >> 16;
+  return x;
+}
+
+/// The two 24-bit integers a tracer's Eq. (10) direction is made of in step `prefix`: `zBits` for z
+/// and `azimuthBits` for the azimuth. Two rounds of hash32(): the first keyed by the stream (a
+/// bijection of the stream for one step, so no two tracers of a step share it), the second by the
+/// first. The step's key is the lower and upper half of prefix.head ^ prefix.tail (SplitMix64 of the
+/// seed, purpose and step). Streams are tracer identities, below 2^31.
+inline void counterDirectionBits(const CounterRngPrefix& prefix, std::uint64_t stream, std::uint32_t& zBits,
+                                 std::uint32_t& azimuthBits) {
+  const std::uint64_t key = prefix.head ^ prefix.tail;
+  const std::uint32_t first = hash32(std::uint32_t(stream) ^ std::uint32_t(key));
+  const std::uint32_t second = hash32(first + std::uint32_t(key >> 32));
+  zBits = first >> 8;
+  azimuthBits = second >> 8;
+}
+
+/// The random unit vector of stream `stream` (uniform on the sphere) in float arithmetic, from
+/// counterDirectionBits(): z = 2 u1 - 1 and the azimuth 2 pi u2 with u = bits / 2^24. The motion
+/// kernel's Eq. (10) direction: its speed is a float per cell already, so a direction to float
+/// precision (|n| = 1 within 3e-7) loses nothing, and float halves the vector work of the double form.
+/// (Until 2026-12-02 the bits came from SplitMix64, CounterRng's first draw: 2x the cost on AVX2.)
 inline void counterUnitVector(const CounterRngPrefix& prefix, std::uint64_t stream, double& x, double& y, double& z) {
-  const std::uint64_t key = mix64(prefix.head + stream) ^ prefix.tail;
-  const std::uint64_t draw = mix64(key + 0x9e3779b97f4a7c15ULL);  // nextU64() of draw 1
+  std::uint32_t zBits, azimuthBits;
+  counterDirectionBits(prefix, stream, zBits, azimuthBits);
   // 24-bit integers convert to float exactly, and 2 u1 - 1 is exact too.
-  const float u1 = float(std::int32_t(draw >> 40)) * 0x1.0p-24f;
-  const float u2 = float(std::int32_t((draw >> 8) & 0xffffffULL)) * 0x1.0p-24f;
+  const float u1 = float(std::int32_t(zBits)) * 0x1.0p-24f;
+  const float u2 = float(std::int32_t(azimuthBits)) * 0x1.0p-24f;
   const float zf = 2.0f * u1 - 1.0f;
   const float r2 = 1.0f - zf * zf;
   const float r = std::sqrt(r2 > 0.0f ? r2 : 0.0f);

@@ -15,14 +15,17 @@
 using namespace rcfd;
 using namespace rcfd::test;
 
-TEST(Kernel, UnitVectorsAreTheCounterDrawsInFloatAndUniform) {
+TEST(Kernel, UnitVectorsAreTheirDirectionBitsInFloatAndUniform) {
   const CounterRngPrefix prefix(42, RngPurpose::Fluctuation, 1234);
   double worst = 0.0, worstNorm = 0.0;
   for (std::uint64_t i = 0; i < 200000; ++i) {
-    // The same first draw as CounterRng's stream, its 24-bit halves evaluated in double with libm.
-    const std::uint64_t draw = CounterRng(prefix, i).nextU64();
-    const double z = 2.0 * (double(draw >> 40) * 0x1.0p-24) - 1.0;
-    const double phi = 2.0 * std::numbers::pi * (double((draw >> 8) & 0xffffff) * 0x1.0p-24);
+    // The same 24-bit integers evaluated in double with libm.
+    std::uint32_t zBits, azimuthBits;
+    counterDirectionBits(prefix, i, zBits, azimuthBits);
+    ASSERT_LT(zBits, 1u << 24);
+    ASSERT_LT(azimuthBits, 1u << 24);
+    const double z = 2.0 * (double(zBits) * 0x1.0p-24) - 1.0;
+    const double phi = 2.0 * std::numbers::pi * (double(azimuthBits) * 0x1.0p-24);
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     const Eigen::Vector3d expected(r * std::cos(phi), r * std::sin(phi), z);
     double x, y, zf;
@@ -34,19 +37,40 @@ TEST(Kernel, UnitVectorsAreTheCounterDrawsInFloatAndUniform) {
   // Float arithmetic: a few ulp of float (6e-8), also near the poles where 1 - z^2 loses digits.
   EXPECT_LT(worst, 1e-6);
   EXPECT_LT(worstNorm, 5e-7);
-  // Uniform on the sphere: E[n] = 0, E[n n^T] = I / 3 (standard errors ~0.0013 and ~0.0007 here).
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+  // Uniform on the sphere, over the tracers of one step and over the steps of one tracer: E[n] = 0,
+  // E[n n^T] = I / 3 (standard errors ~0.0013 and ~0.0007 here), and one tracer's directions in
+  // successive steps uncorrelated, E[n_s . n_s+1] = 0 (standard error ~0.0013).
   const int draws = 200000;
-  for (int i = 0; i < draws; ++i) {
-    double x, y, z;
-    counterUnitVector(prefix, std::uint64_t(i), x, y, z);
-    const Eigen::Vector3d n(x, y, z);
-    mean += n / draws;
-    second += n * n.transpose() / draws;
+  for (const bool overSteps : {false, true}) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero(), previous = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+    double lagOne = 0.0;
+    for (int i = 0; i < draws; ++i) {
+      double x, y, z;
+      if (overSteps) {
+        counterUnitVector(CounterRngPrefix(42, RngPurpose::Fluctuation, std::uint64_t(i)), 7, x, y, z);
+      } else {
+        counterUnitVector(prefix, std::uint64_t(i), x, y, z);
+      }
+      const Eigen::Vector3d n(x, y, z);
+      mean += n / draws;
+      second += n * n.transpose() / draws;
+      lagOne += n.dot(previous) / draws;
+      previous = n;
+    }
+    EXPECT_LT(mean.cwiseAbs().maxCoeff(), 0.006) << overSteps;
+    EXPECT_LT((second - Eigen::Matrix3d::Identity() / 3.0).cwiseAbs().maxCoeff(), 0.004) << overSteps;
+    EXPECT_LT(std::abs(lagOne), 0.006) << overSteps;
   }
-  EXPECT_LT(mean.cwiseAbs().maxCoeff(), 0.006);
-  EXPECT_LT((second - Eigen::Matrix3d::Identity() / 3.0).cwiseAbs().maxCoeff(), 0.004);
+  // Different seeds give different directions to the same tracer in the same step.
+  int same = 0;
+  for (std::uint64_t i = 0; i < 1000; ++i) {
+    std::uint32_t a, b, c, d;
+    counterDirectionBits(CounterRngPrefix(1, RngPurpose::Fluctuation, 5), i, a, b);
+    counterDirectionBits(CounterRngPrefix(2, RngPurpose::Fluctuation, 5), i, c, d);
+    same += a == c || b == d;
+  }
+  EXPECT_LE(same, 1);
   // Quadrant boundaries of the reduction, and the polynomials' accuracy over a fine sweep.
   for (float u : {0.0f, 0.125f, 0.25f, 0.375f, 0.5f, 0.625f, 0.75f, 0.875f, 1.0f - 0x1.0p-24f}) {
     float s, c;
