@@ -88,6 +88,7 @@ struct Context {
   double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
   double halfDiagonal = 0.0;        ///< half a cell diagonal: no point of a cell is farther from its centre [m]
   static constexpr int kMaxSubsteps = 64;  ///< MotionKernel::kMaxSubsteps
+  double substepLength[kMaxSubsteps + 1] = {};  ///< [n] = dt / n [s]
   double inverseStokesTime = 0.0;   ///< 18 rho_G nu_G / (rho_P d_P^2) [1/s]
   double reynoldsPerSpeed = 0.0;    ///< d_P / nu_G [s/m]
   double gravity[3] = {};           ///< [m/s2]
@@ -101,12 +102,15 @@ struct Context {
 
 /// Sub-steps of the lanes of a block so that none moves farther than max_courant cells at its start
 /// velocity u: the arithmetic of substepsFor() in MotionKernel::move() (courant = |u| dt / limit,
-/// given as its inverse, capped at kMax, also for a non-finite u), h = dt / nsub as there. Adds the
-/// extra sub-steps and the capped lanes to the counters; returns the largest number of extra sub-steps.
-/// Not inlined: inlined into MotionKernel::move(), GCC 12 leaves the loop scalar for AVX2 ("control
-/// flow in loop"), out of line it vectorises it (33.4 against 37.2 CPU ns per tracer-step on a Zen 3).
+/// given as its inverse, capped at kMax, also for a non-finite u). The sub-step lengths come from
+/// `lengths` (lengths[n] = dt / n, as there): on AVX-512 the table gather beat a vector division in the
+/// kernel, on AVX2 the two cost the same. Adds the extra sub-steps and the capped lanes to the counters;
+/// returns the largest number of extra sub-steps. Not inlined: inlined into MotionKernel::move(), GCC 12
+/// leaves the loop scalar for AVX2 ("control flow in loop"), out of line it vectorises it (33.4 against
+/// 37.2 CPU ns per tracer-step on a Zen 3).
 [[gnu::noinline]] inline std::int32_t substepsOfBlock(const double* ux, const double* uy, const double* uz,
-                                                      int count, double dt, double inverseLimit, double kMax,
+                                                      int count, double dt, double inverseLimit,
+                                                      const double* lengths, double kMax,
                                                       double* h, std::int32_t* left, std::int64_t& extra,
                                                       std::int64_t& capped) {
   alignas(64) std::int32_t over[kBlock];
@@ -122,7 +126,7 @@ struct Context {
     const std::int32_t whole = std::int32_t(c);  // floor, as c >= 0
     const std::int32_t up = whole + std::int32_t(double(whole) < c);
     const std::int32_t nsub = up > 1 ? up : 1;
-    h[k] = dt / double(nsub);
+    h[k] = lengths[nsub];
     left[k] = nsub - 1;
     over[k] = within ? 0 : 1;
   }

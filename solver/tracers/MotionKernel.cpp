@@ -172,6 +172,7 @@ void MotionKernel::move(TracerContext& ctx) {
   for (int d = 0; d < 3; ++d) bc.gravity[d] = gravity_[d];
   bc.restitution = settings_.wallRestitution;
   static_assert(Context::kMaxSubsteps == kMaxSubsteps);
+  for (int k = 1; k <= kMaxSubsteps; ++k) bc.substepLength[k] = dt / k;  // the scalar path's h = dt / nsub
   bc.cellData = cellData_.data();
   bc.plateReach = plateReach_.empty() ? nullptr : plateReach_.data();
   bc.q = locator.constants();
@@ -348,7 +349,8 @@ void MotionKernel::move(TracerContext& ctx) {
         locateBlock(bc.q, m, L.x, L.y, L.z, stencils);
         sampleBlock(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
         auto countSubsteps = [&](Lanes& lanes) {
-          return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, double(kMaxSubsteps),
+          return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
+                                 double(kMaxSubsteps),
                                  lanes.h, lanes.left, st.substeps, st.substepCapped);
         };
         const bool more = countSubsteps(L) > 0;
