@@ -174,6 +174,18 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
   for (std::int32_t round = 1; round <= maxLeft; ++round) {
     LaneStorage rs;
     const int r = lanesWithSubstepsLeft(L, rs.lane);
+    if (r == L.count) {
+      // Every lane takes this round (always the first round of deferred lanes): in place, no copies.
+      for (int k = 0; k < r; ++k) --L.left[k];
+      Lanes all = L;
+      all.cell = nullptr, all.reach = nullptr;  // later rounds: the cells are not known
+      if (freeFlying) {
+        freeFlightSubStep(all, s, bc, st);
+      } else {
+        subStep(all, s, false, bc, st);
+      }
+      continue;
+    }
     for (int j = 0; j < r; ++j) {
       rs.copyLane(L, rs.lane[j], j);
       --L.left[rs.lane[j]];
