@@ -137,8 +137,9 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
     _mm256_storeu_pd(z + k0, _mm256_blendv_pd(_mm256_loadu_pd(z + k0), _mm256_load_pd(ez + k0), move));
   }
 #endif
+#pragma omp simd
   for (int k = k0; k < m; ++k) {
-    if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];
+    if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];  // masked stores (all lanes with AVX-512)
   }
 #pragma omp simd reduction(+ : exact)
   for (int k = 0; k < m; ++k) exact += 1 - fast[k];
