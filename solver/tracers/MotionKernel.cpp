@@ -350,8 +350,7 @@ void MotionKernel::move(TracerContext& ctx) {
         sampleBlock(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
         auto countSubsteps = [&](Lanes& lanes) {
           return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
-                                 double(kMaxSubsteps),
-                                 lanes.h, lanes.left, st.substeps, st.substepCapped);
+                                 double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);
         };
         const bool more = countSubsteps(L) > 0;
         subStep(L, stencils, true, bc, st);

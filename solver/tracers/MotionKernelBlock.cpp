@@ -188,7 +188,14 @@ void MotionKernel::freeFlightSubStep(block::Lanes& F, block::BlockStencils& s, c
 
 void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::BlockStencils& s, bool freeFlying,
                                 const block::Context& bc, MotionStatistics& st) const {
-  for (std::int32_t round = 1; round <= maxLeft; ++round) {
+  auto subStepRound = [&](Lanes& lanes) {
+    if (freeFlying) {
+      freeFlightSubStep(lanes, s, bc, st);
+    } else {
+      subStep(lanes, s, false, bc, st);
+    }
+  };
+  for (std::int32_t n = 1; n <= maxLeft; ++n) {
     LaneStorage rs;
     const int r = lanesWithSubstepsLeft(L, rs.lane);
     if (r == L.count) {
@@ -196,11 +203,7 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
       for (int k = 0; k < r; ++k) --L.left[k];
       Lanes all = L;
       all.cell = nullptr, all.reach = nullptr;  // later rounds: the cells are not known
-      if (freeFlying) {
-        freeFlightSubStep(all, s, bc, st);
-      } else {
-        subStep(all, s, false, bc, st);
-      }
+      subStepRound(all);
       continue;
     }
     for (int j = 0; j < r; ++j) {
@@ -208,11 +211,7 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
       --L.left[rs.lane[j]];
     }
     Lanes R = rs.view(r);
-    if (freeFlying) {
-      freeFlightSubStep(R, s, bc, st);
-    } else {
-      subStep(R, s, false, bc, st);
-    }
+    subStepRound(R);
     for (int j = 0; j < r; ++j) {
       const int k = rs.lane[j];
       L.x[k] = R.x[j], L.y[k] = R.y[j], L.z[k] = R.z[j];
