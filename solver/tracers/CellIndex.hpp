@@ -25,17 +25,16 @@ class CellIndexer {
   void cellsOf(int count, const double* x, const double* y, const double* z, std::int32_t* out) const {
     // Plain locals: the vectoriser does not look through members.
     const double ox = ox_, oy = oy_, oz = oz_, ihx = ihx_, ihy = ihy_, ihz = ihz_;
-    const int nx = nx_, ny = ny_, nz = nz_;
+    const int nx = nx_, ny = ny_;
+    const double lastX = nx_ - 1, lastY = ny_ - 1, lastZ = nz_ - 1;
 #pragma omp simd
     for (int k = 0; k < count; ++k) {
-      // int(floor(t)) as truncation corrected for negative t (the same integer; floor itself does not
-      // vectorise under GCC's default trapping-math).
-      const double tx = (x[k] - ox) * ihx, ty = (y[k] - oy) * ihy, tz = (z[k] - oz) * ihz;
-      int ci = int(tx), cj = int(ty), ck = int(tz);
-      ci -= double(ci) > tx, cj -= double(cj) > ty, ck -= double(ck) > tz;
-      ci = ci < 0 ? 0 : (ci >= nx ? nx - 1 : ci);
-      cj = cj < 0 ? 0 : (cj >= ny ? ny - 1 : cj);
-      ck = ck < 0 ? 0 : (ck >= nz ? nz - 1 : ck);
+      // Clamped into [0, n - 1] in double, so the truncation is floor (floor itself does not vectorise
+      // under GCC's default trapping-math) and no int conversion overflows; NaN gives cell 0.
+      double tx = (x[k] - ox) * ihx, ty = (y[k] - oy) * ihy, tz = (z[k] - oz) * ihz;
+      tx = tx > 0.0 ? tx : 0.0, ty = ty > 0.0 ? ty : 0.0, tz = tz > 0.0 ? tz : 0.0;
+      tx = tx < lastX ? tx : lastX, ty = ty < lastY ? ty : lastY, tz = tz < lastZ ? tz : lastZ;
+      const int ci = int(tx), cj = int(ty), ck = int(tz);
       out[k] = (ck * ny + cj) * nx + ci;
     }
   }

@@ -2,10 +2,13 @@
 // from: counter-based unit vectors with the polynomial sincos, and the trilinear locator.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <limits>
 #include <numbers>
 #include <random>
 
 #include "tracers/BlockSampling.hpp"
+#include "tracers/CellIndex.hpp"
 #include "tracers/FluctuationModel.hpp"
 #include "tracers/FrameSampler.hpp"
 #include "tracers/SingleSphereDrag.hpp"
@@ -87,6 +90,43 @@ TEST(Kernel, UnitVectorsAreTheirDirectionBitsInFloatAndUniform) {
                           std::abs(c - std::cos(2 * std::numbers::pi * double(u)))});
   }
   EXPECT_LT(worstTrig, 2e-7);
+}
+
+// The vectorised cell lookup of the kernel and of tracer_volume_fraction agrees with the grid's own
+// (floor of the division) inside, and sends every point outside, however far and NaN too, to a cell
+// of the grid: the nearest one, NaN to the first.
+TEST(Kernel, CellIndexerFindsTheGridsCellAndTheNearestOneOutside) {
+  CartesianGrid grid;
+  grid.origin = {-0.1, 0.02, -0.3};
+  grid.spacing = {0.01, 0.02, 0.005};
+  grid.shape = {7, 5, 3};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> inside(0.0, 1.0);
+  std::vector<double> x, y, z;
+  for (int k = 0; k < 200; ++k) {
+    x.push_back(grid.origin.x() + inside(rng) * grid.shape[0] * grid.spacing.x());
+    y.push_back(grid.origin.y() + inside(rng) * grid.shape[1] * grid.spacing.y());
+    z.push_back(grid.origin.z() + inside(rng) * grid.shape[2] * grid.spacing.z());
+  }
+  const std::size_t inGrid = x.size();
+  // Outside, with the cell expected: (i, j, k) of the nearest cell; NaN goes to the first layer.
+  const double huge = 1e30, nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::pair<std::array<double, 3>, std::array<int, 3>>> outside = {
+      {{-1.0, 0.05, -0.2925}, {0, 1, 1}},   {{1.0, 0.05, -0.2925}, {6, 1, 1}},
+      {{-0.055, -huge, -0.2925}, {4, 0, 1}}, {{-0.055, huge, -0.2925}, {4, 4, 1}},
+      {{-0.055, 0.05, huge}, {4, 1, 2}},     {{huge, huge, huge}, {6, 4, 2}},
+      {{-huge, -huge, -huge}, {0, 0, 0}},    {{nan, 0.05, -0.2925}, {0, 1, 1}},
+      {{-0.055, nan, nan}, {4, 0, 0}}};
+  for (const auto& [p, ijk] : outside) x.push_back(p[0]), y.push_back(p[1]), z.push_back(p[2]);
+  std::vector<std::int32_t> cells(x.size());
+  CellIndexer(grid).cellsOf(int(x.size()), x.data(), y.data(), z.data(), cells.data());
+  for (std::size_t k = 0; k < inGrid; ++k) {
+    EXPECT_EQ(cells[k], grid.flatIndexOf({x[k], y[k], z[k]})) << "point " << k;
+  }
+  for (std::size_t k = 0; k < outside.size(); ++k) {
+    const auto& ijk = outside[k].second;
+    EXPECT_EQ(cells[inGrid + k], grid.flatIndex(ijk[0], ijk[1], ijk[2])) << "outside point " << k;
+  }
 }
 
 TEST(Kernel, SamplerMatchesWeightedTrilinearIncludingASingleLayerAndOutside) {
