@@ -126,7 +126,11 @@ struct Context {
     const std::int32_t whole = std::int32_t(c);  // floor, as c >= 0
     const std::int32_t up = whole + std::int32_t(double(whole) < c);
     const std::int32_t nsub = up > 1 ? up : 1;
+#if defined(__AVX512F__)
     h[k] = lengths[nsub];
+#else
+    h[k] = dt / double(nsub);  // = lengths[nsub]; GCC does not gather on Zen, so the table costs lane by lane
+#endif
     left[k] = nsub - 1;
     over[k] = within ? 0 : 1;
   }

@@ -268,14 +268,14 @@ void MotionKernel::move(TracerContext& ctx) {
       alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
       alignas(64) double speed[kBlock];
       alignas(64) float reachOf[kBlock];  // cellData_'s reach of the lane's cell (the first wall test)
-      alignas(64) std::int32_t cellOf[kBlock];
+      alignas(64) std::int32_t cellsFound[kBlock];
       std::int64_t free[kBlock];  // free flight (not bool, which stops the vectoriser)
-      // Cells, then their Eq. (10) speed: independent loads the vectorised loop issues as gathers, so
-      // their cache misses overlap.
+      // The lanes' cells: those the last step found (read in place), or found here.
+      const std::int32_t* cellOf = cellsFound;
       if (haveTracerAlpha) {
-        for (int k = 0; k < count; ++k) cellOf[k] = ctx.tracerCell[std::size_t(i0 + k)];
+        cellOf = ctx.tracerCell.data() + i0;
       } else {
-        indexer.cellsOf(count, px + i0, py + i0, pz + i0, cellOf);
+        indexer.cellsOf(count, px + i0, py + i0, pz + i0, cellsFound);
       }
       std::int64_t freeLanes = 0;
       if (settings_.freeFlight) {
@@ -293,7 +293,8 @@ void MotionKernel::move(TracerContext& ctx) {
         std::uint64_t pair;
         std::memcpy(&pair, cellData + 2 * cellOf[k], sizeof pair);
         reachOf[k] = std::bit_cast<float>(std::uint32_t(pair));
-        speed[k] = double(std::bit_cast<float>(std::uint32_t(pair >> 32))) * double(1 - free[k]);  // none in free flight
+        // none in free flight (a select: AVX2 has no vector int64-to-double conversion)
+        speed[k] = free[k] != 0 ? 0.0 : double(std::bit_cast<float>(std::uint32_t(pair >> 32)));
       }
       // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
       if (fluctuate) {

@@ -114,6 +114,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
 #pragma omp simd
       for (int k = 0; k < m; ++k) inside[k] = off[k] + std::sqrt(length2[k]) < double(plateReach[cell[k]]);
     } else {
+#pragma omp simd
       for (int k = 0; k < m; ++k) inside[k] = 1;
     }
     for (int j = 0; j < bc.halfSpaces; ++j) {
@@ -121,10 +122,19 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
 #pragma omp simd
       for (int k = 0; k < m; ++k) inside[k] &= std::int64_t(nx * ex[k] + ny * ey[k] + nz * ez[k] - c >= margin);
     }
-#pragma omp simd
-    for (int k = 0; k < m; ++k) fast[k] |= inside[k];
+    pending = 0;
+#pragma omp simd reduction(+ : pending)
+    for (int k = 0; k < m; ++k) {
+      fast[k] |= inside[k];
+      pending += 1 - fast[k];
+    }
   }
-  std::int64_t exact = 0;
+  // `pending` lanes are left for the exact test.
+  if (pending == 0) {  // most blocks: every move accepted
+#pragma omp simd
+    for (int k = 0; k < m; ++k) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];
+    return;
+  }
   int k0 = 0;
 #if defined(__AVX2__) && !defined(__AVX512F__)
   // Blends and plain stores: GCC turns this loop, even written as selects, into AVX2 masked stores
@@ -141,9 +151,6 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   for (int k = k0; k < m; ++k) {
     if (fast[k]) x[k] = ex[k], y[k] = ey[k], z[k] = ez[k];  // masked stores (all lanes with AVX-512)
   }
-#pragma omp simd reduction(+ : exact)
-  for (int k = 0; k < m; ++k) exact += 1 - fast[k];
-  if (exact == 0) return;  // most blocks: no lane near enough a wall to need the exact test
   // The rest meet a wall or pass close to one: the exact segment test and mirror reflection, which
   // for a free-flying tracer also reflects its velocity with the restitution coefficient.
   for (int k = 0; k < m; ++k) {
