@@ -132,15 +132,6 @@ void locateFloat(const TrilinearLocator::Constants& q, int count, const float* g
   }
 }
 
-/// u at the located lanes, in float, through the kernel's own per-lane combination.
-void sampleFloat(const float* field, const block::CornerOffsets& co, const block::BlockStencils& s, int count,
-                 float* ux, float* uy, float* uz) {
-  alignas(64) float u4[4 * kBlock];
-  block::sampleBlock4(field, co, s, count, u4);
-#pragma omp simd
-  for (int k = 0; k < count; ++k) ux[k] = u4[4 * k], uy[k] = u4[4 * k + 1], uz[k] = u4[4 * k + 2];
-}
-
 /// The midpoint floor with float lanes: grid coordinates from the double positions once, the midpoint
 /// and the displacement in float, the positions updated in double.
 void floorStepFloat(const FloorCase& c) {
@@ -165,13 +156,13 @@ void floorStepFloat(const FloorCase& c) {
         gx[k] = float((x[k] - ox) * ix), gy[k] = float((y[k] - oy) * iy), gz[k] = float((z[k] - oz) * iz);
       }
       locateFloat(c.q, m, gx, gy, gz, s);
-      sampleFloat(c.field, c.corners, s, m, ux, uy, uz);
+      block::sampleBlock3(c.field, c.corners, s, m, ux, uy, uz);
 #pragma omp simd
       for (int k = 0; k < m; ++k) {
         mx[k] = gx[k] + half * ux[k] * fix, my[k] = gy[k] + half * uy[k] * fiy, mz[k] = gz[k] + half * uz[k] * fiz;
       }
       locateFloat(c.q, m, mx, my, mz, s);
-      sampleFloat(c.field, c.corners, s, m, ux, uy, uz);
+      block::sampleBlock3(c.field, c.corners, s, m, ux, uy, uz);
       double* outX = c.outX + i0;
       double* outY = c.outY + i0;
       double* outZ = c.outZ + i0;
