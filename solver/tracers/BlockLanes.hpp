@@ -103,14 +103,15 @@ struct Context {
 /// Sub-steps of the lanes of a block so that none moves farther than max_courant cells at its start
 /// velocity u: the arithmetic of substepsFor() in MotionKernel::move() (courant = |u| dt / limit,
 /// given as its inverse, capped at kMax, also for a non-finite u). The sub-step lengths come from
-/// `lengths` (lengths[n] = dt / n, as there): on AVX-512 the table gather beat a vector division in the
-/// kernel, on AVX2 the two cost the same. Adds the extra sub-steps and the capped lanes to the counters;
+/// `lengths` (lengths[n] = dt / n, as there) on AVX-512, where the table gather beat a vector division;
+/// elsewhere from the division itself (GCC does not gather on Zen, and the table loaded lane by lane
+/// took 40% of this function's instructions). Adds the extra sub-steps and the capped lanes to the counters;
 /// returns the largest number of extra sub-steps. Not inlined: inlined into MotionKernel::move(), GCC 12
 /// leaves the loop scalar for AVX2 ("control flow in loop"), out of line it vectorises it (33.4 against
 /// 37.2 CPU ns per tracer-step on a Zen 3).
 [[gnu::noinline]] inline std::int32_t substepsOfBlock(const double* ux, const double* uy, const double* uz,
                                                       int count, double dt, double inverseLimit,
-                                                      const double* lengths, double kMax,
+                                                      [[maybe_unused]] const double* lengths, double kMax,
                                                       double* h, std::int32_t* left, std::int64_t& extra,
                                                       std::int64_t& capped) {
   alignas(64) std::int32_t over[kBlock];
@@ -129,7 +130,7 @@ struct Context {
 #if defined(__AVX512F__)
     h[k] = lengths[nsub];
 #else
-    h[k] = dt / double(nsub);  // = lengths[nsub]; GCC does not gather on Zen, so the table costs lane by lane
+    h[k] = dt / double(nsub);  // = lengths[nsub]
 #endif
     left[k] = nsub - 1;
     over[k] = within ? 0 : 1;
