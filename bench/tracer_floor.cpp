@@ -11,13 +11,20 @@
 // counterUnitVector()) and the cells of the moved positions for the next step (CellIndexer::cellsOf()).
 // `midpoint_float` prices a layout the kernel does not have: the midpoint floor with the lanes'
 // arithmetic in float (positions stay double; grid coordinates, velocities and displacements are float,
-// so a vector holds 16 lanes instead of 8).
+// so a vector holds 16 lanes instead of 8). `midpoint_gradient` prices a one-sample second-order step
+// (floorStepGradient()); `error_against_16_substeps` gives the position error of one step of each against a reference.
 #include <algorithm>
+#include <bit>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <iostream>
 #include <iterator>
 #include <vector>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 #include "BenchRegistry.hpp"
 #include "TracerBenchCase.hpp"
@@ -174,6 +181,71 @@ void floorStepFloat(const FloorCase& c) {
   }
 }
 
+/// A one-sample second-order step, priced: u and its gradient from the same 8 corners of one located
+/// sample, x' = x + h (u + h/2 (grad u) u). For a linear field it equals the midpoint rule; on the
+/// trilinear field it extrapolates the start cell's interpolant where the midpoint rule samples the
+/// cell its midpoint lies in. Not what the kernel does: the floor of a kernel that did (AVX2 only:
+/// without it, returns false and moves nothing).
+bool floorStepGradient(const FloorCase& c) {
+#if defined(__AVX2__) && defined(__FMA__)
+  if (!c.corners.adjacentX) return false;
+  const std::int64_t blocks = (c.n + kBlock - 1) / kBlock;
+  constexpr std::int64_t kChunk = 16;
+  const std::int32_t o0 = c.corners.off4[0], o2 = c.corners.off4[2], o4 = c.corners.off4[4], o6 = c.corners.off4[6];
+  // Gradients per grid coordinate times the inverse spacing: per metre.
+  const __m128 inverseSpacing = _mm_setr_ps(float(c.q.ix), float(c.q.iy), float(c.q.iz), 0.0f);
+  const __m128 halfStep = _mm_set1_ps(float(0.5 * c.dt));
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t chunk = 0; chunk < (blocks + kChunk - 1) / kChunk; ++chunk) {
+    block::BlockStencils s;
+    alignas(64) float vx[kBlock], vy[kBlock], vz[kBlock];
+    for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
+      const std::int64_t i0 = b * kBlock;
+      const int m = int(std::min<std::int64_t>(kBlock, c.n - i0));
+      locateBlock(c.q, m, c.x + i0, c.y + i0, c.z + i0, s);
+      for (int k = 0; k < m; ++k) {
+        const float* f = c.field + 4 * std::int64_t(s.base[k]);
+        const __m256 fz = _mm256_set1_ps(s.fz[k]), fy = _mm256_set1_ps(s.fy[k]);
+        const __m256 c01 = _mm256_loadu_ps(f + o0), c23 = _mm256_loadu_ps(f + o2);
+        const __m256 dz01 = _mm256_sub_ps(_mm256_loadu_ps(f + o4), c01);
+        const __m256 dz23 = _mm256_sub_ps(_mm256_loadu_ps(f + o6), c23);
+        const __m256 t01 = _mm256_fmadd_ps(fz, dz01, c01), t23 = _mm256_fmadd_ps(fz, dz23, c23);
+        const __m256 dy = _mm256_sub_ps(t23, t01);
+        const __m256 s01 = _mm256_fmadd_ps(fy, dy, t01);
+        const __m256 ez = _mm256_fmadd_ps(fy, _mm256_sub_ps(dz23, dz01), dz01);
+        const __m128 fx = _mm_set1_ps(s.fx[k]);
+        auto lerpX = [&](__m256 v) {
+          const __m128 lo = _mm256_castps256_ps128(v), hi = _mm256_extractf128_ps(v, 1);
+          return _mm_fmadd_ps(fx, _mm_sub_ps(hi, lo), lo);
+        };
+        const __m128 s0 = _mm256_castps256_ps128(s01), s1 = _mm256_extractf128_ps(s01, 1);
+        const __m128 gx = _mm_sub_ps(s1, s0);
+        const __m128 u = _mm_fmadd_ps(fx, gx, s0);
+        const __m128 gy = lerpX(dy), gz = lerpX(ez);
+        const __m128 w = _mm_mul_ps(u, inverseSpacing);  // (grad u) u = gx wx + gy wy + gz wz
+        __m128 ju = _mm_mul_ps(gx, _mm_shuffle_ps(w, w, 0x00));
+        ju = _mm_fmadd_ps(gy, _mm_shuffle_ps(w, w, 0x55), ju);
+        ju = _mm_fmadd_ps(gz, _mm_shuffle_ps(w, w, 0xaa), ju);
+        const __m128 v = _mm_fmadd_ps(halfStep, ju, u);
+        _mm_store_ss(vx + k, v);
+        vy[k] = std::bit_cast<float>(_mm_extract_ps(v, 1));
+        vz[k] = std::bit_cast<float>(_mm_extract_ps(v, 2));
+      }
+#pragma omp simd
+      for (int k = 0; k < m; ++k) {
+        c.outX[i0 + k] = c.x[i0 + k] + c.dt * double(vx[k]);
+        c.outY[i0 + k] = c.y[i0 + k] + c.dt * double(vy[k]);
+        c.outZ[i0 + k] = c.z[i0 + k] + c.dt * double(vz[k]);
+      }
+    }
+  }
+  return true;
+#else
+  (void)c;
+  return false;
+#endif
+}
+
 nlohmann::json run(const Options& options) {
   TracerBenchCase bench(options);
   // The tracers as the real run has them: placed, and sorted by cell at the first step.
@@ -207,7 +279,7 @@ nlohmann::json run(const Options& options) {
   out["steps"] = steps;
   struct Variant {
     const char* name;
-    int samples;  ///< 1 Euler, 2 midpoint; 0: the midpoint with float lanes (floorStepFloat)
+    int samples;  ///< 1 Euler, 2 midpoint; 0: the midpoint with float lanes (floorStepFloat); -1 floorStepGradient
     FloorParts parts;
   };
   const Variant variants[] = {{"midpoint", 2, {}},
@@ -215,10 +287,13 @@ nlohmann::json run(const Options& options) {
                               {"midpoint_fluctuation", 2, {true, false}},
                               {"midpoint_next_cells", 2, {false, true}},
                               {"midpoint_fluctuation_next_cells", 2, {true, true}},
-                              {"midpoint_float", 0, {}}};
+                              {"midpoint_float", 0, {}},
+                              {"midpoint_gradient", -1, {}}};
   auto stepOf = [&](const Variant& v) {
     if (v.samples == 0) {
       floorStepFloat(c);
+    } else if (v.samples < 0) {
+      floorStepGradient(c);
     } else {
       floorStep(c, v.samples, v.parts, prefix);
     }
@@ -245,6 +320,40 @@ nlohmann::json run(const Options& options) {
                    {"cpu_ns_per_tracer_step", cpu[j] / double(n) * 1e9},
                    {"tracer_steps_per_s", double(n) / wall[j]}};
   }
+  // The one-sample step and the midpoint rule against a reference (the midpoint rule in 16 sub-steps),
+  // one step from the same positions, no walls: RMS and largest position error [m], and the RMS
+  // displacement they compare with. The floor does not sub-step, so at Courant numbers above 1 both
+  // err more than in the kernel.
+  const StepFieldSampler exact(field, sampler.locator());
+  constexpr int kReferenceSubsteps = 16;
+  std::vector<Eigen::Vector3d> reference(count);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    Eigen::Vector3d p(cloud.x[std::size_t(i)], cloud.y[std::size_t(i)], cloud.z[std::size_t(i)]);
+    const double h = c.dt / kReferenceSubsteps;
+    for (int k = 0; k < kReferenceSubsteps; ++k) p += h * exact.sample(p + 0.5 * h * exact.sample(p));
+    reference[std::size_t(i)] = p;
+  }
+  auto errors = [&](const char* name) {
+    double error2 = 0.0, largest = 0.0, move2 = 0.0;
+    for (std::size_t i = 0; i < count; ++i) {
+      const Eigen::Vector3d p(outX[i], outY[i], outZ[i]);
+      const Eigen::Vector3d start(cloud.x[i], cloud.y[i], cloud.z[i]);
+      error2 += (p - reference[i]).squaredNorm(), largest = std::max(largest, (p - reference[i]).norm());
+      move2 += (reference[i] - start).squaredNorm();
+    }
+    out["error_against_16_substeps"][name] = {{"rms_m", std::sqrt(error2 / double(count))},
+                                              {"max_m", largest},
+                                              {"rms_displacement_m", std::sqrt(move2 / double(count))}};
+    std::cerr << name << " against the midpoint rule in " << kReferenceSubsteps << " sub-steps, one step: RMS error "
+              << std::sqrt(error2 / double(count)) << " m, largest " << largest << " m (RMS displacement "
+              << std::sqrt(move2 / double(count)) << " m)\n";
+  };
+  floorStep(c, 2, {}, prefix);
+  errors("midpoint");
+  floorStep(c, 1, {}, prefix);
+  errors("euler");
+  if (floorStepGradient(c)) errors("midpoint_gradient");
   double checksum = 0.0;  // keeps the stores observable
   for (std::int64_t i = 0; i < n; i += 997) checksum += outX[std::size_t(i)] + outY[std::size_t(i)] + outZ[std::size_t(i)];
   out["position_checksum"] = checksum;
