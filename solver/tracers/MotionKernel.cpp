@@ -293,8 +293,11 @@ void MotionKernel::move(TracerContext& ctx) {
         std::uint64_t pair;
         std::memcpy(&pair, cellData + 2 * cellOf[k], sizeof pair);
         reachOf[k] = std::bit_cast<float>(std::uint32_t(pair));
-        // none in free flight (a select: AVX2 has no vector int64-to-double conversion)
-        speed[k] = free[k] != 0 ? 0.0 : double(std::bit_cast<float>(std::uint32_t(pair >> 32)));
+        speed[k] = double(std::bit_cast<float>(std::uint32_t(pair >> 32)));
+      }
+      if (freeLanes > 0) {  // none in free flight (a select: AVX2 has no vector int64-to-double conversion)
+  #pragma omp simd
+        for (int k = 0; k < count; ++k) speed[k] = free[k] != 0 ? 0.0 : speed[k];
       }
       // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
       if (fluctuate) {
