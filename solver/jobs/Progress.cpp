@@ -6,7 +6,18 @@
 namespace rcfd {
 
 ProgressReporter::ProgressReporter(bool json, double intervalSeconds, std::string label)
-    : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
+    : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {
+  eta_.restart(0.0, 0.0);
+}
+
+double EtaEstimate::update(double t, double fraction) {
+  samples_.emplace_back(t, fraction);
+  // Keep the newest sample at or before the window's start, so the rate spans the whole window.
+  while (samples_.size() > 2 && samples_[1].first <= t - window_) samples_.pop_front();
+  const auto& [t0, f0] = samples_.front();
+  const double rate = t > t0 ? (fraction - f0) / (t - t0) : 0.0;
+  return rate > 0.0 ? (1.0 - fraction) / rate : -1.0;
+}
 
 double ProgressReporter::wallTime() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -16,8 +27,7 @@ void ProgressReporter::report(double fraction, double simTime, bool force) {
   const double now = wallTime();
   if (!force && now - lastReport_ < interval_) return;
   lastReport_ = now;
-  const double done = fraction - startFraction_;
-  const double eta = done > 0.0 ? now / done * (1.0 - fraction) : -1.0;
+  const double eta = eta_.update(now, fraction);
   const double wall = prior_ + now;
   if (json_) {
     nlohmann::json line = {{"fraction", fraction}, {"sim_time", simTime}, {"wall_time", wall},

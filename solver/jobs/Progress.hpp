@@ -2,12 +2,35 @@
 /// \file Progress.hpp
 /// Progress of a running job: a human line on stderr and, with --progress-json, one JSON object per line
 /// on stdout ({"fraction","sim_time","wall_time","eta_s"}, CONTRACTS.md) -- what the server's workers
-/// read. Throttled to about one report per `interval` seconds of wall time.
+/// read. Throttled to about one report per `interval` seconds of wall time. The ETA uses the rate of
+/// the last minute (EtaEstimate).
 
 #include <chrono>
+#include <deque>
 #include <string>
+#include <utility>
 
 namespace rcfd {
+
+/// Remaining wall time from the rate over the last `window` seconds of reports, not since the start:
+/// a job whose machine got busy (or idle again) shows an estimate that follows within the window
+/// instead of one averaged over the whole run (a demo starved by a build showed 7 h for 10 min left).
+class EtaEstimate {
+ public:
+  explicit EtaEstimate(double windowSeconds = 60.0) : window_(windowSeconds) {}
+  /// Starts over from `fraction` done at wall time `t` [s].
+  void restart(double t, double fraction) {
+    samples_.clear();
+    samples_.emplace_back(t, fraction);
+  }
+  /// Adds `fraction` done at wall time `t` [s] (non-decreasing); returns the seconds left, or -1 while
+  /// no progress has been seen in the window.
+  double update(double t, double fraction);
+
+ private:
+  double window_;
+  std::deque<std::pair<double, double>> samples_;  ///< (wall time [s], fraction), oldest first
+};
 
 class ProgressReporter {
  public:
@@ -19,16 +42,16 @@ class ProgressReporter {
   /// Wall seconds already spent before a resume, counted into wall_time and the rate.
   void setPriorWallTime(double seconds) { prior_ = seconds; }
   /// Fraction already done when this process started (so the ETA uses this process's rate only).
-  void setStartFraction(double fraction) { startFraction_ = fraction; }
+  void setStartFraction(double fraction) { eta_.restart(wallTime(), fraction); }
 
  private:
   bool json_;
   double interval_;
   std::string label_;
   double prior_ = 0.0;
-  double startFraction_ = 0.0;
   std::chrono::steady_clock::time_point start_;
   double lastReport_ = -1e300;
+  EtaEstimate eta_;
 };
 
 }  // namespace rcfd
