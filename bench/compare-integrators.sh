@@ -10,12 +10,8 @@ out=$(cd "${1:-demo}" && pwd)
 bin=$(pwd)/build
 work=$(mktemp -d)
 db=$(jq -r '.database' "$out/spray-job.json")
-"$bin/rcfd-server" --data-dir "$out/data" --listen 127.0.0.1:0 --workers 1 >"$work/server.out" 2>"$work/server.log" &
-pid=$!
-trap 'kill "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true' EXIT
-for _ in $(seq 1 200); do grep -q '^listening on ' "$work/server.out" 2>/dev/null && break; sleep 0.05; done
-export RCFD_SERVER=$(sed -n 's/^listening on //p' "$work/server.out" | head -n1)
-export RCFD_TOKEN=$(cat "$out/data/token")
+source scripts/server-lib.sh
+start_rcfd_server "$bin" "$out/data" "$work"
 rcfd() { "$bin/rcfd" "$@"; }
 finish() { rcfd wait "$1" >/dev/null && rcfd result "$1" >"$2"; }
 

@@ -13,18 +13,8 @@ mkdir -p "$out/data"
 out=$(cd "$out" && pwd)
 bin=$(pwd)/build
 
-"$bin/rcfd-server" --data-dir "$out/data" --listen 127.0.0.1:0 --workers 1 \
-  >"$out/server.out" 2>"$out/server.log" &
-server_pid=$!
-trap 'kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
-for _ in $(seq 1 200); do
-  grep -q '^listening on ' "$out/server.out" 2>/dev/null && break
-  kill -0 "$server_pid" 2>/dev/null || { cat "$out/server.log" >&2; exit 1; }
-  sleep 0.05
-done
-export RCFD_SERVER=$(sed -n 's/^listening on //p' "$out/server.out" | head -n1)
-# The server takes RCFD_TOKEN when it is set, else it keeps (or creates) one in its data dir.
-export RCFD_TOKEN=${RCFD_TOKEN:-$(cat "$out/data/token")}
+source scripts/server-lib.sh
+start_rcfd_server "$bin" "$out/data" "$out"
 rcfd() { "$bin/rcfd" "$@"; }
 echo "server: $RCFD_SERVER (data in $out/data, log $out/server.log)"
 
