@@ -3,7 +3,7 @@
 # through the job server (scripts/pipeline.sh): rcfd-server with a local data dir, database ->
 # calibration -> spray on examples/quick.json submitted with the rcfd client, progress shown, the
 # coverage distribution (CSV, HDF5) and its SVG downloaded into demo/. Also draws each example
-# apparatus into demo/. On 2 idle cores it takes about 20 minutes from a fresh clone (build ~11, pipeline ~8,
+# apparatus into demo/. On 2 idle cores it takes about 25 minutes from a fresh clone (build ~15, pipeline ~10,
 # mostly the CFD-DEM database job).
 set -euo pipefail
 cd "$(dirname "$0")/.."
