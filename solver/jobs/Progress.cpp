@@ -6,9 +6,7 @@
 namespace rcfd {
 
 ProgressReporter::ProgressReporter(bool json, double intervalSeconds, std::string label)
-    : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {
-  eta_.restart(0.0, 0.0);
-}
+    : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
 
 double EtaEstimate::update(double t, double fraction) {
   samples_.emplace_back(t, fraction);

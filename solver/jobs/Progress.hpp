@@ -17,7 +17,8 @@ namespace rcfd {
 /// instead of one averaged over the whole run (a demo starved by a build showed 7 h for 10 min left).
 class EtaEstimate {
  public:
-  explicit EtaEstimate(double windowSeconds = 60.0) : window_(windowSeconds) {}
+  /// Starts from nothing done at wall time 0.
+  explicit EtaEstimate(double windowSeconds = 60.0) : window_(windowSeconds) { restart(0.0, 0.0); }
   /// Starts over from `fraction` done at wall time `t` [s].
   void restart(double t, double fraction) {
     samples_.clear();

@@ -14,6 +14,8 @@ TEST(EtaEstimate, SteadyProgressGivesTheRemainingTimeAtThatRate) {
   double left = -1.0;
   for (int t = 1; t <= 50; ++t) left = eta.update(double(t), t / 100.0);  // 1% per second
   EXPECT_NEAR(left, 50.0, 1e-9);
+  EtaEstimate fresh;  // without restart(): from nothing done at time 0
+  EXPECT_NEAR(fresh.update(10.0, 0.1), 90.0, 1e-9);
 }
 
 TEST(EtaEstimate, FollowsASlowdownWithinTheWindowWhereTheAverageSinceTheStartWouldNot) {
