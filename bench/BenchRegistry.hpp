@@ -2,8 +2,8 @@
 /// \file BenchRegistry.hpp
 /// rcfd-bench NAME [--quick] [--json] [--threads N]: each bench/*.cpp registers one named benchmark.
 /// A benchmark prints human-readable lines as it goes and returns its figures as a JSON object; with
-/// --json, main prints that object as the last line of stdout, with "benchmark", "threads", "cpu" and
-/// "vector_isa" added
+/// --json, main prints that object as the last line of stdout, with "benchmark", "threads", "cpu",
+/// "vector_isa" and "omp_wait_policy" added
 /// (CONTRACTS.md: tracers -> tracer_steps_per_s, spray -> sim_seconds_per_wall_second,
 /// dem -> particle_steps_per_s, recurrence -> matrix_seconds, accuracy -> document).
 

@@ -1,5 +1,6 @@
 // rcfd-bench: runs one registered benchmark (bench/BenchRegistry.hpp).
 #include <CLI/CLI.hpp>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -19,8 +20,9 @@ std::map<std::string, Entry>& registry() {
   return instance;
 }
 /// The CPU as /proc/cpuinfo names it, with its family and model numbers ("AMD EPYC (family 25, model
-/// 1)"), or "unknown": this project's VMs have been AVX-512 Zen 5s (family 26) and AVX2 Zen 3s
-/// (family 25) under the same generic name, whose figures differ by 2x, so every result says which.
+/// 1)"), or "unknown": this project's VMs have been AVX-512 Zen 5s (family 26), AVX2 Zen 3s
+/// (family 25), both "AMD EPYC", and an AVX-512 Emerald Rapids ("Intel Xeon", family 6, model 207),
+/// whose figures differ by up to 2x, so every result says which.
 std::string cpuName() {
   std::ifstream in("/proc/cpuinfo");
   std::string name = "unknown", family = "?", model = "?";
@@ -48,6 +50,14 @@ const char* vectorIsa() {
 #else
   return "scalar";
 #endif
+}
+
+/// OMP_WAIT_POLICY as set, or "default" (libgomp spins a while before it sleeps, as the server and
+/// rcfd-solve run): on 2 threads a passive wait costs 0.4-0.5 ms per spray step, 7-10% of it, so a
+/// figure means little without it.
+std::string waitPolicy() {
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  return policy && *policy ? policy : "default";
 }
 }  // namespace
 bool addBenchmark(std::string name, std::string description, Benchmark run) {
@@ -80,6 +90,7 @@ int main(int argc, char** argv) {
   result["threads"] = options.threads > 0 ? options.threads : omp_get_max_threads();
   result["cpu"] = cpuName();
   result["vector_isa"] = vectorIsa();
+  result["omp_wait_policy"] = waitPolicy();
   result["quick"] = options.quick;
   if (json) std::cout << result.dump() << std::endl;
   else std::cout << result.dump(2) << std::endl;
