@@ -7,6 +7,7 @@
 #include <numbers>
 #include <random>
 
+#include "tracers/BlockLanes.hpp"
 #include "tracers/BlockSampling.hpp"
 #include "tracers/CellIndex.hpp"
 #include "tracers/FluctuationModel.hpp"
@@ -337,4 +338,48 @@ TEST(Kernel, VectorisedFluctuationSpeedsEqualThePerCellOnes) {
       EXPECT_GT(moving, capped) << name;  // speeds below it occurred
     }
   }
+}
+
+// substepsOfBlock(): blocks whose lanes all stay within one limit take a shortcut past the square
+// roots; it must give what the exact count gives, on both sides of a Courant number of 1 and for NaN.
+TEST(Kernel, SubstepCountOfABlockIsCeilOfTheCourantNumber) {
+  using block::kBlock;
+  constexpr double dt = 5e-3, limit = 0.01, kMax = 64.0;
+  std::array<double, 65> lengths{};
+  for (int n = 1; n <= 64; ++n) lengths[std::size_t(n)] = dt / double(n);
+  auto count = [&](const std::vector<double>& courant, std::vector<double>& h, std::vector<std::int32_t>& left,
+                   std::int64_t& extra, std::int64_t& capped) {
+    const int m = int(courant.size());
+    alignas(64) double ux[kBlock] = {}, uy[kBlock] = {}, uz[kBlock] = {};
+    for (int k = 0; k < m; ++k) ux[k] = courant[std::size_t(k)] * limit / dt;  // |u| dt / limit = courant
+    alignas(64) double hb[kBlock];
+    alignas(64) std::int32_t lb[kBlock];
+    const std::int32_t most =
+        block::substepsOfBlock(ux, uy, uz, m, dt, 1.0 / limit, lengths.data(), kMax, hb, lb, extra, capped);
+    h.assign(hb, hb + m), left.assign(lb, lb + m);
+    return most;
+  };
+  std::vector<double> h;
+  std::vector<std::int32_t> left;
+  std::int64_t extra = 0, capped = 0;
+  // Every lane slower than one limit: one sub-step of dt each.
+  EXPECT_EQ(count(std::vector<double>(kBlock, 0.9), h, left, extra, capped), 0);
+  for (int k = 0; k < kBlock; ++k) EXPECT_EQ(h[std::size_t(k)], dt) << k;
+  for (int k = 0; k < kBlock; ++k) EXPECT_EQ(left[std::size_t(k)], 0) << k;
+  EXPECT_EQ(extra, 0);
+  // Every lane just beyond one limit: none may take the shortcut.
+  EXPECT_EQ(count(std::vector<double>(kBlock, 1.0 + 1e-9), h, left, extra, capped), 1);
+  for (int k = 0; k < kBlock; ++k) EXPECT_EQ(left[std::size_t(k)], 1) << k;
+  // Lanes around 1 and beyond kMax, and a NaN velocity (capped at kMax sub-steps).
+  const std::vector<double> courant = {0.0, 1.0 - 1e-12, 1.0 + 1e-9, 2.5, 100.0,
+                                       std::numeric_limits<double>::quiet_NaN(), 0.5};
+  const std::vector<std::int32_t> expected = {1, 1, 2, 3, 64, 64, 1};
+  extra = 0, capped = 0;
+  EXPECT_EQ(count(courant, h, left, extra, capped), 63);
+  for (std::size_t k = 0; k < courant.size(); ++k) {
+    EXPECT_EQ(left[k], expected[k] - 1) << "courant " << courant[k];
+    EXPECT_EQ(h[k], dt / double(expected[k])) << "courant " << courant[k];
+  }
+  EXPECT_EQ(extra, 0 + 0 + 1 + 2 + 63 + 63 + 0);
+  EXPECT_EQ(capped, 2);
 }
