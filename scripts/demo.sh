@@ -3,8 +3,8 @@
 # through the job server (scripts/pipeline.sh): rcfd-server with a local data dir, database ->
 # calibration -> spray on examples/quick.json submitted with the rcfd client, progress shown, the
 # coverage distribution (CSV, HDF5) and its SVG downloaded into demo/. Also draws each example
-# apparatus into demo/. On 2 idle cores it takes about 25 minutes from a fresh clone (build ~15, pipeline ~10,
-# mostly the CFD-DEM database job).
+# apparatus into demo/. On 2 idle cores it takes 15-25 minutes from a fresh clone (15 on an Intel Emerald
+# Rapids, 25 on an AVX2 Zen 3: build ~15, pipeline ~10, mostly the CFD-DEM database job).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
