@@ -367,6 +367,9 @@ TEST(Kernel, SubstepCountOfABlockIsCeilOfTheCourantNumber) {
   for (int k = 0; k < kBlock; ++k) EXPECT_EQ(h[std::size_t(k)], dt) << k;
   for (int k = 0; k < kBlock; ++k) EXPECT_EQ(left[std::size_t(k)], 0) << k;
   EXPECT_EQ(extra, 0);
+  // Every lane just below one limit, inside the shortcut's margin: the exact count, still one each.
+  EXPECT_EQ(count(std::vector<double>(kBlock, 1.0 - 1e-12), h, left, extra, capped), 0);
+  for (int k = 0; k < kBlock; ++k) EXPECT_EQ(h[std::size_t(k)], dt) << k;
   // Every lane just beyond one limit: none may take the shortcut.
   EXPECT_EQ(count(std::vector<double>(kBlock, 1.0 + 1e-9), h, left, extra, capped), 1);
   for (int k = 0; k < kBlock; ++k) EXPECT_EQ(left[std::size_t(k)], 1) << k;
