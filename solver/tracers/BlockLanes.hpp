@@ -20,7 +20,7 @@ namespace rcfd::block {
 /// of the cloud's arrays (the common case, no copies) or of a LaneStorage (compacted lanes).
 struct Lanes {
   double *x, *y, *z;         ///< position [m]
-  const double *ax, *ay, *az;  ///< u_fluc of Eq. (10) [m/s]
+  const float *ax, *ay, *az;  ///< u_fluc of Eq. (10) [m/s]
   double *ux, *uy, *uz;      ///< velocity of the sub-step [m/s]
   double* h;                 ///< sub-step [s]
   std::int32_t* left;        ///< sub-steps still to take after this round
@@ -34,7 +34,7 @@ struct Lanes {
 /// Storage of compacted lanes.
 struct LaneStorage {
   alignas(64) double x[kBlock], y[kBlock], z[kBlock];
-  alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];
+  alignas(64) float ax[kBlock], ay[kBlock], az[kBlock];
   alignas(64) double ux[kBlock], uy[kBlock], uz[kBlock];
   alignas(64) double h[kBlock];
   alignas(64) std::int32_t left[kBlock];
@@ -93,6 +93,7 @@ struct Context {
   const float* cellData = nullptr;  ///< MotionKernel::cellData_
   const float* plateReach = nullptr;  ///< per cell, or null without draft plates
   TrilinearLocator::Constants q{};
+  GridConstants grid;               ///< q for grid coordinates in float
   CornerOffsets corners;            ///< corner offsets in floats of the step fields
   double origin[3] = {}, inv[3] = {}, spacing[3] = {};
   int last[3] = {};

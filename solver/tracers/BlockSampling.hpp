@@ -31,6 +31,10 @@ constexpr int kBlock = 64;
 struct BlockStencils {
   alignas(64) float fx[kBlock], fy[kBlock], fz[kBlock];
   alignas(64) std::int32_t base[kBlock];
+  /// The grid coordinates of the points last located and u sampled there, in float (the midpoint rule
+  /// steps from them)
+  alignas(64) float gx[kBlock], gy[kBlock], gz[kBlock];
+  alignas(64) float ux[kBlock], uy[kBlock], uz[kBlock];
 };
 
 /// The combination of the 8 corners (corner c at c4 + off4[c], 4 floats each; bit 0 of c is x, bit 1
@@ -64,6 +68,70 @@ inline void locateBlock(const TrilinearLocator::Constants& q, int count, const d
     s.fx[k] = float(TrilinearLocator::Constants::axis(x[k], ox, ix, lastX, maxX, lx));
     s.fy[k] = float(TrilinearLocator::Constants::axis(y[k], oy, iy, lastY, maxY, ly));
     s.fz[k] = float(TrilinearLocator::Constants::axis(z[k], oz, iz, lastZ, maxZ, lz));
+    s.base[k] = lx + ly * sy + lz * sz;
+  }
+}
+
+/// The grid coordinates g = (x - origin) / spacing of a point along one axis, in float: the motion
+/// kernel locates u_P^rec samples and takes midpoints in them (16 lanes per AVX-512 vector where
+/// double positions give 8). Rounding g to float moves a point by at most 2^-24 g cells, a few 1e-8 m
+/// on the paper's grid, far below the float precision of the field itself.
+inline float gridCoordinate(double x, double origin, double inverseSpacing) { return float((x - origin) * inverseSpacing); }
+
+/// Base cell along one axis and fraction of grid coordinate g (TrilinearLocator::Constants::axis() in
+/// float, on g instead of x).
+inline float gridAxis(float g, float last, int maxLow, int& lo) {
+  float t = g - 0.5f;
+  t = t > 0.0f ? t : 0.0f;  // branch-free: vectorises
+  t = t < last ? t : last;
+  const int i = int(t);
+  lo = i < maxLow ? i : maxLow;
+  return t - float(lo);
+}
+
+/// The grid's constants for gridAxis(), as plain values.
+struct GridConstants {
+  double ox = 0, oy = 0, oz = 0, ix = 0, iy = 0, iz = 0;  ///< origin, inverse spacing (double: g's rounding only)
+  float fix = 0, fiy = 0, fiz = 0;                        ///< inverse spacing in float (midpoints)
+  float lastX = 0, lastY = 0, lastZ = 0;
+  int maxX = 0, maxY = 0, maxZ = 0;
+  std::int32_t sy = 0, sz = 0;
+  explicit GridConstants(const TrilinearLocator::Constants& q = {})
+      : ox(q.ox), oy(q.oy), oz(q.oz), ix(q.ix), iy(q.iy), iz(q.iz), fix(float(q.ix)), fiy(float(q.iy)),
+        fiz(float(q.iz)), lastX(float(q.lastX)), lastY(float(q.lastY)), lastZ(float(q.lastZ)), maxX(q.maxX),
+        maxY(q.maxY), maxZ(q.maxZ), sy(q.sy), sz(q.sz) {}
+  /// Base index and fractions of the point with grid coordinates (gx, gy, gz).
+  std::int32_t locate(float gx, float gy, float gz, float& fx, float& fy, float& fz) const {
+    int lx, ly, lz;
+    fx = gridAxis(gx, lastX, maxX, lx);
+    fy = gridAxis(gy, lastY, maxY, ly);
+    fz = gridAxis(gz, lastZ, maxZ, lz);
+    return lx + ly * sy + lz * sz;
+  }
+};
+
+/// Grid coordinates of the block's points (x, y, z).
+inline void gridCoordinatesOfBlock(const GridConstants& q, int count, const double* x, const double* y,
+                                   const double* z, float* gx, float* gy, float* gz) {
+  const double ox = q.ox, oy = q.oy, oz = q.oz, ix = q.ix, iy = q.iy, iz = q.iz;
+#pragma omp simd
+  for (int k = 0; k < count; ++k) {
+    gx[k] = gridCoordinate(x[k], ox, ix), gy[k] = gridCoordinate(y[k], oy, iy), gz[k] = gridCoordinate(z[k], oz, iz);
+  }
+}
+
+/// Base indices and fractions of the block's points given by grid coordinates, into `s`.
+inline void locateGridBlock(const GridConstants& q, int count, const float* gx, const float* gy, const float* gz,
+                            BlockStencils& s) {
+  const float lastX = q.lastX, lastY = q.lastY, lastZ = q.lastZ;
+  const int maxX = q.maxX, maxY = q.maxY, maxZ = q.maxZ;
+  const std::int32_t sy = q.sy, sz = q.sz;
+#pragma omp simd
+  for (int k = 0; k < count; ++k) {
+    int lx, ly, lz;
+    s.fx[k] = gridAxis(gx[k], lastX, maxX, lx);
+    s.fy[k] = gridAxis(gy[k], lastY, maxY, ly);
+    s.fz[k] = gridAxis(gz[k], lastZ, maxZ, lz);
     s.base[k] = lx + ly * sy + lz * sz;
   }
 }
@@ -123,6 +191,19 @@ inline void sampleBlock(const float* field, const CornerOffsets& co, const Block
     ux[k] = double(fx[k]) + ax[k];
     uy[k] = double(fy[k]) + ay[k];
     uz[k] = double(fz[k]) + az[k];
+  }
+}
+
+/// u = trilinear(field; stencil) + (ax, ay, az) in float for the lanes of a block located in `s`: into
+/// (fx, fy, fz), and as double into (ux, uy, uz).
+inline void sampleBlockFloat(const float* field, const CornerOffsets& co, const BlockStencils& s, int count,
+                             const float* ax, const float* ay, const float* az, float* fx, float* fy, float* fz,
+                             double* ux, double* uy, double* uz) {
+  sampleBlock3(field, co, s, count, fx, fy, fz);
+#pragma omp simd
+  for (int k = 0; k < count; ++k) {
+    fx[k] += ax[k], fy[k] += ay[k], fz[k] += az[k];
+    ux[k] = double(fx[k]), uy[k] = double(fy[k]), uz[k] = double(fz[k]);
   }
 }
 

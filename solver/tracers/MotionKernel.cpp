@@ -176,6 +176,7 @@ void MotionKernel::move(TracerContext& ctx) {
   bc.cellData = cellData_.data();
   bc.plateReach = plateReach_.empty() ? nullptr : plateReach_.data();
   bc.q = locator.constants();
+  bc.grid = GridConstants(bc.q);
   bc.corners.set(locator.offsets32());
   for (int d = 0; d < 3; ++d) {
     bc.origin[d] = grid_.origin[d], bc.inv[d] = 1.0 / grid_.spacing[d], bc.spacing[d] = grid_.spacing[d];
@@ -196,7 +197,7 @@ void MotionKernel::move(TracerContext& ctx) {
 
   // The scalar path: free flight, and every tracer when the block path is off (tests compare both).
   // Counters go through `st`, not captured: a capture would bypass the OpenMP reduction's copies.
-  auto moveOne = [&](std::int64_t i, std::int64_t cell, const Eigen::Vector3d& fluc, MotionStatistics& st) {
+  auto moveOne = [&](std::int64_t i, std::int64_t cell, const Eigen::Vector3f& fluc, MotionStatistics& st) {
     Eigen::Vector3d p = cloud.position(std::size_t(i));
     Eigen::Vector3d v = cloud.velocity(std::size_t(i));
     // The first move of a tracer starts in `cell`: its clearance is known (walls on) or unused.
@@ -218,18 +219,26 @@ void MotionKernel::move(TracerContext& ctx) {
       }
       st.substeps += nsub - 1;
     } else {
+      // u_P^rec in float at float grid coordinates, as the block path (block::locateGridBlock()).
       const StepFieldSampler up(particleVelocity_, locator);
-      Eigen::Vector3d u = up.sample(p) + fluc;  // Eq. (9)
-      const int nsub = substepsFor(u.norm() * dt, st.substepCapped);
+      const Eigen::Vector3f inverseSpacing = up.inverseSpacing();
+      Eigen::Vector3f g = up.gridCoordinates(p);
+      Eigen::Vector3f uf = up.sampleAtGrid(g) + fluc;  // Eq. (9)
+      const int nsub = substepsFor(uf.cast<double>().norm() * dt, st.substepCapped);
       const double h = dt / nsub;
       for (int s = 0; s < nsub; ++s) {
-        if (s > 0) u = up.sample(p) + fluc;
+        if (s > 0) g = up.gridCoordinates(p), uf = up.sampleAtGrid(g) + fluc;
         // Midpoint rule: Euler spirals outward in rotating flow (|x| grows by sqrt(1 + (omega h)^2)
         // per step); the midpoint velocity makes that error O((omega h)^4).
-        if (midpoint) u = up.sample(Eigen::Vector3d(p + 0.5 * h * u)) + fluc;
-        st.wallHits += moveWithWalls(p, h * u, nullptr, 1.0, s == 0 ? firstClearance : -1.0);
+        if (midpoint) {
+          const float half = float(0.5 * h);
+          Eigen::Vector3f mid;
+          for (int d = 0; d < 3; ++d) mid[d] = g[d] + half * (uf[d] * inverseSpacing[d]);
+          uf = up.sampleAtGrid(mid) + fluc;
+        }
+        st.wallHits += moveWithWalls(p, h * uf.cast<double>(), nullptr, 1.0, s == 0 ? firstClearance : -1.0);
       }
-      v = u;
+      v = uf.cast<double>();
       st.substeps += nsub - 1;
     }
     cloud.setPosition(std::size_t(i), p);
@@ -265,8 +274,8 @@ void MotionKernel::move(TracerContext& ctx) {
     for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
       const std::int64_t i0 = b * kBlock;
       const int count = int(std::min<std::int64_t>(kBlock, n - i0));
-      alignas(64) double ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
-      alignas(64) double speed[kBlock];
+      alignas(64) float ax[kBlock], ay[kBlock], az[kBlock];  // u_fluc
+      alignas(64) float speed[kBlock];
       alignas(64) float reachOf[kBlock];  // cellData_'s reach of the lane's cell (the first wall test)
       alignas(64) std::int32_t cellsFound[kBlock];
       std::int64_t free[kBlock];  // free flight (not bool, which stops the vectoriser)
@@ -293,26 +302,26 @@ void MotionKernel::move(TracerContext& ctx) {
         std::uint64_t pair;
         std::memcpy(&pair, cellData + 2 * cellOf[k], sizeof pair);
         reachOf[k] = std::bit_cast<float>(std::uint32_t(pair));
-        speed[k] = double(std::bit_cast<float>(std::uint32_t(pair >> 32)));
+        speed[k] = std::bit_cast<float>(std::uint32_t(pair >> 32));
       }
       if (freeLanes > 0) {  // none in free flight (a select: AVX2 has no vector int64-to-double conversion)
   #pragma omp simd
-        for (int k = 0; k < count; ++k) speed[k] = free[k] != 0 ? 0.0 : speed[k];
+        for (int k = 0; k < count; ++k) speed[k] = free[k] != 0 ? 0.0f : speed[k];
       }
       // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
       if (fluctuate) {
   #pragma omp simd
         for (int k = 0; k < count; ++k) {
-          double nx, ny, nz;
-          counterUnitVector(rngPrefix, std::uint64_t(ids[i0 + k]), nx, ny, nz);  // the tracer's own stream
+          float nx, ny, nz;
+          counterUnitVectorFloat(rngPrefix, std::uint64_t(ids[i0 + k]), nx, ny, nz);  // the tracer's own stream
           ax[k] = speed[k] * nx, ay[k] = speed[k] * ny, az[k] = speed[k] * nz;
         }
       } else {
-        for (int k = 0; k < count; ++k) ax[k] = ay[k] = az[k] = 0.0;
+        for (int k = 0; k < count; ++k) ax[k] = ay[k] = az[k] = 0.0f;
       }
       if (!vectorised) {
         for (int k = 0; k < count; ++k) {
-          moveOne(i0 + k, cellOf[k], Eigen::Vector3d(ax[k], ay[k], az[k]), st);
+          moveOne(i0 + k, cellOf[k], Eigen::Vector3f(ax[k], ay[k], az[k]), st);
           ++st.scalarPath;
         }
       } else {
@@ -327,7 +336,7 @@ void MotionKernel::move(TracerContext& ctx) {
             if ((free[k] != 0) != freeFlying) continue;
             ls.x[j] = px[i0 + k], ls.y[j] = py[i0 + k], ls.z[j] = pz[i0 + k];
             ls.ux[j] = pvx[i0 + k], ls.uy[j] = pvy[i0 + k], ls.uz[j] = pvz[i0 + k];  // free flight's own velocity
-            ls.ax[j] = freeFlying ? 0.0 : ax[k], ls.ay[j] = freeFlying ? 0.0 : ay[k], ls.az[j] = freeFlying ? 0.0 : az[k];
+            ls.ax[j] = freeFlying ? 0.0f : ax[k], ls.ay[j] = freeFlying ? 0.0f : ay[k], ls.az[j] = freeFlying ? 0.0f : az[k];
             ls.cell[j] = cellOf[k], ls.reach[j] = reachOf[k];
             ls.lane[j++] = k;
           }
@@ -350,8 +359,10 @@ void MotionKernel::move(TracerContext& ctx) {
         if (freeLanes > 0) L = takeLanes(false, compact);
         const int m = L.count;
         // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
-        locateBlock(bc.q, m, L.x, L.y, L.z, stencils);
-        sampleBlock(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+        gridCoordinatesOfBlock(bc.grid, m, L.x, L.y, L.z, stencils.gx, stencils.gy, stencils.gz);
+        locateGridBlock(bc.grid, m, stencils.gx, stencils.gy, stencils.gz, stencils);
+        sampleBlockFloat(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, stencils.ux, stencils.uy, stencils.uz,
+                         L.ux, L.uy, L.uz);
         auto countSubsteps = [&](Lanes& lanes) {
           return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
                                  double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);

@@ -20,18 +20,20 @@ void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sample
                            MotionStatistics& st) const {
   const int m = L.count;
   if (!sampled) {  // Eq. (9): u_P^rec at the sub-step's start
-    locateBlock(bc.q, m, L.x, L.y, L.z, s);
-    sampleBlock(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+    gridCoordinatesOfBlock(bc.grid, m, L.x, L.y, L.z, s.gx, s.gy, s.gz);
+    locateGridBlock(bc.grid, m, s.gx, s.gy, s.gz, s);
+    sampleBlockFloat(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, s.ux, s.uy, s.uz, L.ux, L.uy, L.uz);
   }
-  if (bc.midpoint) {  // the midpoint rule (see moveOne)
-    alignas(64) double mx[kBlock], my[kBlock], mz[kBlock];
+  if (bc.midpoint) {  // the midpoint rule (see moveOne), in grid coordinates
+    alignas(64) float mx[kBlock], my[kBlock], mz[kBlock];
+    const float fix = bc.grid.fix, fiy = bc.grid.fiy, fiz = bc.grid.fiz;
 #pragma omp simd
     for (int k = 0; k < m; ++k) {
-      const double half = 0.5 * L.h[k];
-      mx[k] = L.x[k] + half * L.ux[k], my[k] = L.y[k] + half * L.uy[k], mz[k] = L.z[k] + half * L.uz[k];
+      const float half = float(0.5 * L.h[k]);
+      mx[k] = s.gx[k] + half * (s.ux[k] * fix), my[k] = s.gy[k] + half * (s.uy[k] * fiy), mz[k] = s.gz[k] + half * (s.uz[k] * fiz);
     }
-    locateBlock(bc.q, m, mx, my, mz, s);
-    sampleBlock(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, L.ux, L.uy, L.uz);
+    locateGridBlock(bc.grid, m, mx, my, mz, s);
+    sampleBlockFloat(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, s.ux, s.uy, s.uz, L.ux, L.uy, L.uz);
   }
   moveLanes(L, bc, st, false);
 }

@@ -54,9 +54,27 @@ class StepVelocityField {
 /// parcels sample with it.
 class StepFieldSampler {
  public:
-  StepFieldSampler(const StepVelocityField& field, const TrilinearLocator& locator) : field_(field), locator_(locator) {
+  StepFieldSampler(const StepVelocityField& field, const TrilinearLocator& locator)
+      : field_(field), locator_(locator), grid_(locator.constants()) {
     corners_.set(locator.offsets32());
   }
+  /// Grid coordinates of p in float (block::gridCoordinate()): where the motion kernel's u_P^rec
+  /// samples and midpoints are taken.
+  Eigen::Vector3f gridCoordinates(const Eigen::Vector3d& p) const {
+    return {block::gridCoordinate(p.x(), grid_.ox, grid_.ix), block::gridCoordinate(p.y(), grid_.oy, grid_.iy),
+            block::gridCoordinate(p.z(), grid_.oz, grid_.iz)};
+  }
+  /// u at grid coordinates g, in float: the arithmetic of block::locateGridBlock() and sampleBlock3().
+  Eigen::Vector3f sampleAtGrid(const Eigen::Vector3f& g) const {
+    float f[3];
+    const std::int32_t base = grid_.locate(g.x(), g.y(), g.z(), f[0], f[1], f[2]);
+    Eigen::Vector3f u;
+    block::interpolateCorners(field_.floats() + 4 * std::int64_t(base), corners_.off4, f[0], f[1], f[2], u.data());
+    return u;
+  }
+  /// The inverse grid spacing in float, per axis (midpoints in grid coordinates).
+  Eigen::Vector3f inverseSpacing() const { return {grid_.fix, grid_.fiy, grid_.fiz}; }
+
   Eigen::Vector3d sample(const Eigen::Vector3d& p) const {
     const TrilinearStencil s = locator_.locate(p);
     float u[3];
@@ -68,6 +86,7 @@ class StepFieldSampler {
  private:
   const StepVelocityField& field_;
   const TrilinearLocator& locator_;
+  block::GridConstants grid_;
   block::CornerOffsets corners_;
 };
 

@@ -60,7 +60,7 @@ inline void counterDirectionBits(const CounterRngPrefix& prefix, std::uint64_t s
 /// kernel's Eq. (10) direction: its speed is a float per cell already, so a direction to float
 /// precision (|n| = 1 within 3e-7) loses nothing, and float halves the vector work of the double form.
 /// (Until 2026-12-02 the bits came from SplitMix64, CounterRng's first draw: 2x the cost on AVX2.)
-inline void counterUnitVector(const CounterRngPrefix& prefix, std::uint64_t stream, double& x, double& y, double& z) {
+inline void counterUnitVectorFloat(const CounterRngPrefix& prefix, std::uint64_t stream, float& x, float& y, float& z) {
   std::uint32_t zBits, azimuthBits;
   counterDirectionBits(prefix, stream, zBits, azimuthBits);
   // 24-bit integers convert to float exactly, and 2 u1 - 1 is exact too.
@@ -71,7 +71,14 @@ inline void counterUnitVector(const CounterRngPrefix& prefix, std::uint64_t stre
   const float r = std::sqrt(r2 > 0.0f ? r2 : 0.0f);
   float s, c;
   sinCosTwoPiFloat(u2, s, c);
-  x = double(r * c), y = double(r * s), z = double(zf);
+  x = r * c, y = r * s, z = zf;
+}
+
+/// counterUnitVectorFloat() as doubles.
+inline void counterUnitVector(const CounterRngPrefix& prefix, std::uint64_t stream, double& x, double& y, double& z) {
+  float fx, fy, fz;
+  counterUnitVectorFloat(prefix, stream, fx, fy, fz);
+  x = double(fx), y = double(fy), z = double(fz);
 }
 
 }  // namespace rcfd
