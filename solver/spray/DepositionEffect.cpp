@@ -19,6 +19,7 @@
 #include "spray/DepositionEfficiency.hpp"
 #include "spray/SprayState.hpp"
 #include "tracers/CounterRng.hpp"
+#include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
@@ -76,7 +77,11 @@ class DepositionEffect final : public TracerEffect {
     const std::int64_t n = std::int64_t(pc.size());
     s.parcelDeposit.assign(std::size_t(n), 0.0);
     s.parcelCell.assign(std::size_t(n), 0);
+    // |u_G - u_P| from the step fields the spray parcels and the motion kernel read (float trilinear):
+    // 2 x 8 corners in double per parcel cost as much as moving the parcels.
     const FrameSampler sampler = ctx.sampler();
+    const StepFieldSampler gas(ctx.stepVelocity(true), sampler.locator());
+    const StepFieldSampler particles(ctx.stepVelocity(false), sampler.locator());
 #pragma omp parallel for schedule(static) if (n > kParallelThreshold)
     for (std::int64_t j = 0; j < n; ++j) {
       const Eigen::Vector3d p = pc.position(std::size_t(j));
@@ -86,7 +91,7 @@ class DepositionEffect final : public TracerEffect {
       // No tracers, no deposition (eta = 0, Eq. 11): most airborne parcels are above the bed, and the
       // two velocity samples are the dear part.
       if (!(alphaP > 0.0)) continue;
-      const DepositionInput in{alphaP, (sampler.velocity(p, true) - sampler.velocity(p, false)).norm(), ctx.dt};
+      const DepositionInput in{alphaP, (gas.sample(p) - particles.sample(p)).norm(), ctx.dt};
       s.parcelDeposit[std::size_t(j)] = pc.droplets[std::size_t(j)] * model_->efficiency(in, constants_);
     }
     // Only the cells of the last step's deposits hold anything: zeroed one by one, not all 74k.

@@ -37,7 +37,7 @@ class SprayEffect final : public TracerEffect {
   }
 
   std::size_t allocatedBytes() const override {
-    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + gasField_.bytes() + exit_.capacity();
+    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + exit_.capacity();
   }
 
   void afterMove(TracerContext& ctx) override {
@@ -141,8 +141,8 @@ class SprayEffect final : public TracerEffect {
     // u_G^rec of the step as a 4-float step field, blended once per cell: parcels read its corners with
     // the tracer kernel's block functions (float trilinear, block::interpolateCorners) instead of
     // blending and converting 8 corners in double per sub-step.
-    gasField_.build(frames, true, ctx.grid.cellCount() > kParallelThreshold);
-    BlockMove move{gasField_.floats(), frames.locator().constants(), {}, CellIndexer(ctx.grid), ctx.dt, minSpacing_};
+    const StepVelocityField& gas = ctx.stepVelocity(true);
+    BlockMove move{gas.floats(), frames.locator().constants(), {}, CellIndexer(ctx.grid), ctx.dt, minSpacing_};
     move.corners.set(frames.locator().offsets32());
     const std::int64_t blocks = (n + block::kBlock - 1) / block::kBlock;
     // Blocks start at multiples of kBlock and parcels are independent: the same for any thread count.
@@ -258,7 +258,6 @@ class SprayEffect final : public TracerEffect {
   double launchSpread_ = 0.0;
   double minSpacing_ = 1.0;
   std::vector<float> clearance_;  ///< per cell: moves shorter than this hit no boundary [m]
-  StepVelocityField gasField_;    ///< u_G^rec of the step (rebuilt every step with parcels airborne)
   std::vector<std::int8_t> exit_; ///< per parcel of the step: 0 airborne, 1 wall, 2 outlet
 };
 

@@ -100,11 +100,11 @@ int MotionKernel::moveWithWalls(Eigen::Vector3d& p, Eigen::Vector3d disp, Eigen:
   return bounces;  // gave up after kMaxBounces: p is the last point known to be inside
 }
 
-void MotionKernel::prepare(const TracerContext& ctx, const FrameSampler& sampler, bool fluctuate) {
+void MotionKernel::prepare(TracerContext& ctx, const FrameSampler& sampler, bool fluctuate) {
   const std::int64_t cells = grid_.cellCount();
   const bool parallel = cells > kParallelThreshold;
-  particleVelocity_.build(sampler, false, parallel);
-  if (settings_.freeFlight) gasVelocity_.build(sampler, true, parallel);
+  particleVelocity_ = &ctx.stepVelocity(false);
+  gasVelocity_ = settings_.freeFlight ? &ctx.stepVelocity(true) : nullptr;
   if (cellData_.empty()) {
     cellData_.assign(2 * std::size_t(cells), 0.0f);
     if (settings_.walls) {
@@ -165,8 +165,8 @@ void MotionKernel::move(TracerContext& ctx) {
   const bool midpoint = settings_.midpoint;
 
   Context bc;
-  bc.field = particleVelocity_.floats();
-  bc.gasField = settings_.freeFlight ? gasVelocity_.floats() : nullptr;
+  bc.field = particleVelocity_->floats();
+  bc.gasField = settings_.freeFlight ? gasVelocity_->floats() : nullptr;
   bc.inverseStokesTime = inverseStokesTime_;
   bc.reynoldsPerSpeed = reynoldsPerSpeed_;
   for (int d = 0; d < 3; ++d) bc.gravity[d] = gravity_[d];
@@ -205,7 +205,7 @@ void MotionKernel::move(TracerContext& ctx) {
     if (settings_.freeFlight && sampler.alphaP(cell) < settings_.freeFlightAlpha) {
       // Free flight: implicit drag relaxation toward u_G^rec plus gravity, stable for any dt / tau.
       ++st.freeFlight;
-      const StepFieldSampler gas(gasVelocity_, locator);
+      const StepFieldSampler gas(*gasVelocity_, locator);
       const int nsub = substepsFor(v.norm() * dt, st.substepCapped);
       const double h = dt / nsub;
       for (int s = 0; s < nsub; ++s) {
@@ -220,7 +220,7 @@ void MotionKernel::move(TracerContext& ctx) {
       st.substeps += nsub - 1;
     } else {
       // u_P^rec in float at float grid coordinates, as the block path (block::locateGridBlock()).
-      const StepFieldSampler up(particleVelocity_, locator);
+      const StepFieldSampler up(*particleVelocity_, locator);
       const Eigen::Vector3f inverseSpacing = up.inverseSpacing();
       Eigen::Vector3f g = up.gridCoordinates(p);
       Eigen::Vector3f uf = up.sampleAtGrid(g) + fluc;  // Eq. (9)

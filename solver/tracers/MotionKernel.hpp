@@ -50,7 +50,7 @@ class MotionKernel {
 
  private:
   /// Builds the step's velocity fields and cell table from the context's frames and tracer alpha_P.
-  void prepare(const TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
+  void prepare(TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
   // The block path (MotionKernelBlock.cpp).
   /// The sub-steps after the first of lanes: rounds on the lanes that still have some, compacted.
   void advanceLanes(block::Lanes& lanes, std::int32_t maxLeft, block::BlockStencils& stencils, bool freeFlying,
@@ -84,8 +84,8 @@ class MotionKernel {
   double reynoldsPerSpeed_;       ///< d_P / nu_G [s/m]
   Eigen::Vector3d gravity_{0.0, -9.81, 0.0};
   MotionStatistics stats_;
-  StepVelocityField particleVelocity_;  ///< u_P^rec of the step
-  StepVelocityField gasVelocity_;       ///< u_G^rec of the step (free flight only)
+  const StepVelocityField* particleVelocity_ = nullptr;  ///< u_P^rec of the step (TracerContext::stepFields)
+  const StepVelocityField* gasVelocity_ = nullptr;       ///< u_G^rec of the step (free flight only)
   /// Per cell, the two numbers a tracer reads from its own cell, side by side so they cost one cache
   /// line: [2c] reach_ [m] (0 without walls), [2c+1] |u_fluc| of Eq. (10) capped at
   /// u_fluc_max [m/s] (0 without fluctuation).

@@ -49,6 +49,26 @@ class StepVelocityField {
   std::vector<Eigen::Array4f> data_;
 };
 
+/// The step's u_P^rec and u_G^rec as step fields, each built on its first use in a step and then shared
+/// by every stage that reads it (the motion kernel, the spray parcels, deposition): a field no stage
+/// reads is never built, and none is built twice. TracerSimulation invalidates them when the step's
+/// frames change.
+class StepFields {
+ public:
+  void invalidate() { built_[0] = built_[1] = false; }
+  /// u_P^rec (useGas false) or u_G^rec of the sampler's frames.
+  const StepVelocityField& velocity(const FrameSampler& sampler, bool useGas, bool parallel) {
+    const int k = useGas ? 1 : 0;
+    if (!built_[k]) fields_[k].build(sampler, useGas, parallel), built_[k] = true;
+    return fields_[k];
+  }
+  std::size_t bytes() const { return fields_[0].bytes() + fields_[1].bytes(); }
+
+ private:
+  StepVelocityField fields_[2];
+  bool built_[2] = {false, false};
+};
+
 /// u at single points of a step field, with the motion kernel's block arithmetic
 /// (block::interpolateCorners, float) for one point: the motion kernel's scalar path and the spray
 /// parcels sample with it.

@@ -13,6 +13,7 @@
 #include "geometry/Apparatus.hpp"
 #include "scene/Scene.hpp"
 #include "tracers/FrameSampler.hpp"
+#include "tracers/StepField.hpp"
 #include "tracers/TracerCloud.hpp"
 
 namespace rcfd {
@@ -42,6 +43,11 @@ struct TracerContext {
   std::shared_ptr<const FieldFrame> nextFrame;  ///< next frame of the same sequence, when blending
   double blend = 0.0;                           ///< weight of nextFrame in [0, 1)
   FrameSampler sampler() const { return FrameSampler(grid, frame.get(), nextFrame.get(), blend); }
+  /// u_P^rec or u_G^rec of this step as a step field (built on first use in the step).
+  const StepVelocityField& stepVelocity(bool useGas) {
+    return stepFields.velocity(sampler(), useGas, grid.cellCount() > kParallelThreshold);
+  }
+  StepFields stepFields;  ///< invalidated whenever frame, nextFrame or blend change
 
   // Provided by `tracer_volume_fraction` (empty otherwise).
   std::vector<std::int32_t> tracerCell;   ///< cell of every tracer at the start of the step

@@ -95,6 +95,7 @@ void TracerSimulation::loadFrames() {
   context_->frame = database_->frame(frame);
   context_->nextFrame = blend > 0.0 ? database_->frame(next) : nullptr;
   context_->blend = blend;
+  context_->stepFields.invalidate();
 }
 
 void TracerSimulation::placeTracers() {
