@@ -24,6 +24,7 @@ nlohmann::json runTracers(const Options& options) {
 
   scene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
   if (const char* e = std::getenv("RCFD_BENCH_INTEGRATOR")) scene.rcfd.integrator = e;
+  if (const char* e = std::getenv("RCFD_BENCH_MAX_COURANT")) scene.rcfd.max_courant = std::atof(e);
   if (const char* e = std::getenv("RCFD_BENCH_EFFECTS")) {
     scene.effects.clear();
     std::string s(e);
