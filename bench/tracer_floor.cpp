@@ -9,9 +9,10 @@
 // Two of the kernel's other parts can be added to the midpoint floor, each with the kernel's own
 // function: the Eq. (10) direction (the tracer's cell read, its cell's speed gathered,
 // counterUnitVector()) and the cells of the moved positions for the next step (CellIndexer::cellsOf()).
-// `midpoint_float` prices a layout the kernel does not have: the midpoint floor with the lanes'
-// arithmetic in float (positions stay double; grid coordinates, velocities and displacements are float,
-// so a vector holds 16 lanes instead of 8). `midpoint_gradient` prices a one-sample second-order step
+// `midpoint_float` prices the midpoint floor with the lanes' arithmetic in float (positions stay double;
+// grid coordinates, velocities and displacements are float, so a vector holds 16 lanes instead of 8);
+// since 2026-12-03 the kernel locates and takes midpoints in float grid coordinates as it does, with the
+// same functions, and keeps its displacements in double. `midpoint_gradient` prices a one-sample second-order step
 // (floorStepGradient()); `error_against_16_substeps` gives the position error of one step of each against a reference.
 #include <algorithm>
 #include <bit>
@@ -114,38 +115,13 @@ void floorStep(const FloorCase& c, int samples, FloorParts parts, const CounterR
   }
 }
 
-/// Base indices and fractions from grid coordinates g = (x - origin) / spacing in float: the axis
-/// arithmetic of TrilinearLocator::Constants::axis() at float width.
-void locateFloat(const TrilinearLocator::Constants& q, int count, const float* gx, const float* gy, const float* gz,
-                 block::BlockStencils& s) {
-  const float lastX = float(q.lastX), lastY = float(q.lastY), lastZ = float(q.lastZ);
-  const int maxX = q.maxX, maxY = q.maxY, maxZ = q.maxZ;
-  const std::int32_t sy = q.sy, sz = q.sz;
-  auto axis = [](float g, float last, int maxLow, int& lo) {
-    float t = g - 0.5f;
-    t = t > 0.0f ? t : 0.0f;
-    t = t < last ? t : last;
-    const int i = int(t);
-    lo = i < maxLow ? i : maxLow;
-    return t - float(lo);
-  };
-#pragma omp simd
-  for (int k = 0; k < count; ++k) {
-    int lx, ly, lz;
-    s.fx[k] = axis(gx[k], lastX, maxX, lx);
-    s.fy[k] = axis(gy[k], lastY, maxY, ly);
-    s.fz[k] = axis(gz[k], lastZ, maxZ, lz);
-    s.base[k] = lx + ly * sy + lz * sz;
-  }
-}
-
 /// The midpoint floor with float lanes: grid coordinates from the double positions once, the midpoint
 /// and the displacement in float, the positions updated in double.
 void floorStepFloat(const FloorCase& c) {
   const std::int64_t blocks = (c.n + kBlock - 1) / kBlock;
   constexpr std::int64_t kChunk = 16;
-  const double ox = c.q.ox, oy = c.q.oy, oz = c.q.oz, ix = c.q.ix, iy = c.q.iy, iz = c.q.iz;
-  const float fix = float(ix), fiy = float(iy), fiz = float(iz);
+  const block::GridConstants grid(c.q);
+  const float fix = grid.fix, fiy = grid.fiy, fiz = grid.fiz;
   const float dt = float(c.dt), half = 0.5f * float(c.dt);
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t chunk = 0; chunk < (blocks + kChunk - 1) / kChunk; ++chunk) {
@@ -158,17 +134,14 @@ void floorStepFloat(const FloorCase& c) {
       const double* x = c.x + i0;
       const double* y = c.y + i0;
       const double* z = c.z + i0;
-#pragma omp simd
-      for (int k = 0; k < m; ++k) {
-        gx[k] = float((x[k] - ox) * ix), gy[k] = float((y[k] - oy) * iy), gz[k] = float((z[k] - oz) * iz);
-      }
-      locateFloat(c.q, m, gx, gy, gz, s);
+      block::gridCoordinatesOfBlock(grid, m, x, y, z, gx, gy, gz);
+      block::locateGridBlock(grid, m, gx, gy, gz, s);
       block::sampleBlock3(c.field, c.corners, s, m, ux, uy, uz);
 #pragma omp simd
       for (int k = 0; k < m; ++k) {
         mx[k] = gx[k] + half * ux[k] * fix, my[k] = gy[k] + half * uy[k] * fiy, mz[k] = gz[k] + half * uz[k] * fiz;
       }
-      locateFloat(c.q, m, mx, my, mz, s);
+      block::locateGridBlock(grid, m, mx, my, mz, s);
       block::sampleBlock3(c.field, c.corners, s, m, ux, uy, uz);
       double* outX = c.outX + i0;
       double* outY = c.outY + i0;
