@@ -117,6 +117,14 @@ struct Context {
   bool keepVelocity = false;
 };
 
+/// Eq. (9): u = u_P^rec + u_fluc at the lanes' positions, located in float grid coordinates: into the
+/// lanes' velocities, and in float with the grid coordinates into `s` (the midpoint rule steps from them).
+inline void sampleParticleVelocity(const Context& bc, Lanes& L, BlockStencils& s) {
+  gridCoordinatesOfBlock(bc.grid, L.count, L.x, L.y, L.z, s.gx, s.gy, s.gz);
+  locateGridBlock(bc.grid, L.count, s.gx, s.gy, s.gz, s);
+  sampleBlockFloat(bc.field, bc.corners, s, L.count, L.ax, L.ay, L.az, s.ux, s.uy, s.uz, L.ux, L.uy, L.uz);
+}
+
 /// Below this fraction of one limit squared, a lane's Courant number is at most 1 whatever the rounding
 /// of the exact test in substepsOfBlock() (its relative error is a few 1e-16).
 constexpr double kOneSubstepMargin = 1.0 - 1e-9;

@@ -357,12 +357,8 @@ void MotionKernel::move(TracerContext& ctx) {
         Lanes L{px + i0, py + i0, pz + i0, ax, ay, az, keep ? pvx + i0 : sux, keep ? pvy + i0 : suy,
                 keep ? pvz + i0 : suz, h, left, count, cellOf, reachOf};
         if (freeLanes > 0) L = takeLanes(false, compact);
-        const int m = L.count;
         // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps (as substepsFor).
-        gridCoordinatesOfBlock(bc.grid, m, L.x, L.y, L.z, stencils.gx, stencils.gy, stencils.gz);
-        locateGridBlock(bc.grid, m, stencils.gx, stencils.gy, stencils.gz, stencils);
-        sampleBlockFloat(bc.field, bc.corners, stencils, m, L.ax, L.ay, L.az, stencils.ux, stencils.uy, stencils.uz,
-                         L.ux, L.uy, L.uz);
+        sampleParticleVelocity(bc, L, stencils);
         auto countSubsteps = [&](Lanes& lanes) {
           return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, dt, inverseCellLimit, bc.substepLength,
                                  double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);

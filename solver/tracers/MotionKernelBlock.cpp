@@ -19,11 +19,7 @@ using namespace block;
 void MotionKernel::subStep(block::Lanes& L, block::BlockStencils& s, bool sampled, const block::Context& bc,
                            MotionStatistics& st) const {
   const int m = L.count;
-  if (!sampled) {  // Eq. (9): u_P^rec at the sub-step's start
-    gridCoordinatesOfBlock(bc.grid, m, L.x, L.y, L.z, s.gx, s.gy, s.gz);
-    locateGridBlock(bc.grid, m, s.gx, s.gy, s.gz, s);
-    sampleBlockFloat(bc.field, bc.corners, s, m, L.ax, L.ay, L.az, s.ux, s.uy, s.uz, L.ux, L.uy, L.uz);
-  }
+  if (!sampled) sampleParticleVelocity(bc, L, s);  // Eq. (9) at the sub-step's start
   if (bc.midpoint) {  // the midpoint rule (see moveOne), in grid coordinates
     alignas(64) float mx[kBlock], my[kBlock], mz[kBlock];
     const float fix = bc.grid.fix, fiy = bc.grid.fiy, fiz = bc.grid.fiz;
