@@ -196,7 +196,12 @@ void TracerSimulation::sortTracers() {
   auto& s = sortScratch_;
   s.cell.resize(n), s.from.resize(n);
   s.start.assign(cells + 1, 0);
-  CellIndexer(ctx.grid).cellsOf(int(n), cloud_.x.data(), cloud_.y.data(), cloud_.z.data(), s.cell.data());
+  const bool takesCells = ctx.nextTracerCell.size() == n;  // tracer_volume_fraction takes them back below
+  if (takesCells && ctx.nextTracerCellStep == ctx.step) {
+    s.cell.swap(ctx.nextTracerCell);  // the motion kernel found them for these positions
+  } else {
+    CellIndexer(ctx.grid).cellsOf(int(n), cloud_.x.data(), cloud_.y.data(), cloud_.z.data(), s.cell.data());
+  }
   // Counting sort by cell, stable: the same order for any thread count and on resume.
   for (const std::int32_t c : s.cell) ++s.start[std::size_t(c) + 1];
   for (std::size_t c = 0; c < cells; ++c) s.start[c + 1] += s.start[c];
@@ -207,7 +212,7 @@ void TracerSimulation::sortTracers() {
   }
   applyPermutation(cloud_.id, s.from, s.ints);
   for (auto& e : effects_) e->permuteTracers(ctx, s.from);
-  if (ctx.nextTracerCell.size() == n) {  // the cells are known: tracer_volume_fraction takes them
+  if (takesCells) {  // the cells are known: tracer_volume_fraction takes them
     applyPermutation(s.cell, s.from, s.ints);
     ctx.nextTracerCell.swap(s.cell);
     ctx.nextTracerCellStep = ctx.step;
