@@ -43,8 +43,6 @@ class StepVelocityField {
   /// The field as 4 floats per cell (x, y, z, 0).
   const float* floats() const { return data_.empty() ? nullptr : data_[0].data(); }
 
-  std::size_t bytes() const { return data_.capacity() * sizeof(Eigen::Array4f); }
-
  private:
   std::vector<Eigen::Array4f> data_;
 };
@@ -62,7 +60,6 @@ class StepFields {
     if (!built_[k]) fields_[k].build(sampler, useGas, parallel), built_[k] = true;
     return fields_[k];
   }
-  std::size_t bytes() const { return fields_[0].bytes() + fields_[1].bytes(); }
 
  private:
   StepVelocityField fields_[2];
