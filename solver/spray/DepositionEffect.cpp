@@ -50,6 +50,7 @@ class DepositionEffect final : public TracerEffect {
            (due_.capacity() + slot_.capacity()) * sizeof(std::int32_t);
   }
 
+  bool afterMoveBesideMotion() const override { return true; }
   void afterMove(TracerContext& ctx) override {
     stripParcels(ctx);
     handOut(ctx);

@@ -18,6 +18,7 @@ class DepositionMapsEffect final : public TracerEffect {
 
   std::size_t allocatedBytes() const override { return sum_.capacity() * sizeof(double); }
 
+  bool afterMoveBesideMotion() const override { return true; }
   void afterMove(TracerContext& ctx) override {
     if (!ctx.collecting()) return;
     // cellDeposit is 0 outside depositCells: adding only those cells gives the same sums.

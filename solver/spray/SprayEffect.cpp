@@ -40,6 +40,7 @@ class SprayEffect final : public TracerEffect {
     return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + exit_.capacity();
   }
 
+  bool afterMoveBesideMotion() const override { return true; }
   void afterMove(TracerContext& ctx) override {
     auto& s = *ctx.spray;
     moveParcels(ctx, s);

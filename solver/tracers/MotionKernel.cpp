@@ -4,8 +4,11 @@
 #include <bit>
 #include <cstring>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <string>
+
+#include <omp.h>
 
 #include "core/Errors.hpp"
 #include "geometry/WallClearance.hpp"
@@ -136,10 +139,13 @@ void MotionKernel::prepare(TracerContext& ctx, const FrameSampler& sampler, bool
 }
 
 
-void MotionKernel::move(TracerContext& ctx) {
+void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside) {
   using namespace block;
   stats_ = {};
-  if (!settings_.transport) return;
+  if (!settings_.transport) {
+    if (beside) beside();
+    return;
+  }
   TracerCloud& cloud = ctx.cloud;
   const FrameSampler sampler = ctx.sampler();
   const TrilinearLocator& locator = sampler.locator();
@@ -265,8 +271,20 @@ void MotionKernel::move(TracerContext& ctx) {
   std::int32_t* const nextCells = ctx.nextTracerCell.size() == cloud.size() ? ctx.nextTracerCell.data() : nullptr;
   const CellIndexer indexer(grid_);
   const std::int64_t chunks = (blocks + kChunk - 1) / kChunk;
-#pragma omp parallel for schedule(dynamic, 1) if (n > kParallelThreshold) \
+  // `beside` on the team's last thread, which then takes what chunks are left (an exception is carried
+  // out of the parallel region, which it must not leave).
+  std::exception_ptr besideFailure;
+#pragma omp parallel if (n > kParallelThreshold) \
     reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests)
+  {
+  if (beside && omp_get_thread_num() == omp_get_num_threads() - 1) {
+    try {
+      beside();
+    } catch (...) {
+      besideFailure = std::current_exception();
+    }
+  }
+#pragma omp for schedule(dynamic, 1) nowait
   for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {
     MotionStatistics st;
     DeferredLanes deferred, deferredFree;
@@ -389,6 +407,8 @@ void MotionKernel::move(TracerContext& ctx) {
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
     scalarPath += st.scalarPath, exactWallTests += st.exactWallTests;
   }
+  }
+  if (besideFailure) std::rethrow_exception(besideFailure);
   if (nextCells) ctx.nextTracerCellStep = ctx.step + 1;
   stats_.substeps = substeps;
   stats_.wallHits = wallHits;

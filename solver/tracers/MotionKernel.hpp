@@ -7,6 +7,7 @@
 /// counter-based random stream, so results are bit-identical for any thread count.
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "geometry/Apparatus.hpp"
@@ -38,7 +39,10 @@ class MotionKernel {
 
   MotionKernel(const TracerContext& ctx, const MotionSettings& settings);
 
-  void move(TracerContext& ctx);
+  /// Moves the tracers one step. `beside`, if given, runs once on one thread of the kernel's team
+  /// while the other threads move tracers (that thread then joins them); it must not touch what the
+  /// move reads or writes. With one thread it runs before the move.
+  void move(TracerContext& ctx, const std::function<void()>& beside = {});
   const MotionStatistics& statistics() const { return stats_; }
   const MotionSettings& settings() const { return settings_; }
 

@@ -6,7 +6,7 @@
 ///
 /// Per step the simulation calls, for every effect in dependency order: beforeMove(), then the motion
 /// kernel moves the tracers (configured by the motion effects through configureMotion()), then
-/// afterMove().
+/// afterMove() (beside the move for the effects that say afterMoveBesideMotion()).
 
 #include <functional>
 #include <map>
@@ -43,6 +43,13 @@ class TracerEffect {
   virtual void configureMotion(MotionSettings&) {}
   virtual void beforeMove(TracerContext&) {}
   virtual void afterMove(TracerContext&) {}
+  /// True when afterMove() reads nothing the motion kernel writes in the step (positions, velocities,
+  /// TracerContext::nextTracerCell) and nothing that an effect whose afterMove() is not beside the
+  /// motion writes there: then it runs on one thread of the kernel's team while the others move tracers
+  /// (in effect order among such effects), with the same results as after the move. The spray effects
+  /// are such: parcels, droplets and deposits depend on the step's frames and the tracers' cells and
+  /// alpha_P at its start, not on where the tracers go.
+  virtual bool afterMoveBesideMotion() const { return false; }
   /// Bytes this effect allocated (fields, series, per-tracer arrays).
   virtual std::size_t allocatedBytes() const { return 0; }
   /// Adds the effect's results to result.h5 and summary.json.

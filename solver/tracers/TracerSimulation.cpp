@@ -160,9 +160,22 @@ void TracerSimulation::step() {
     effects_[i]->beforeMove(ctx);
     effectSeconds_[i] += since(t);
   }
-  kernel_->move(ctx);
+  // The effects whose afterMove() does not depend on the move run beside it, timed on their thread.
+  std::function<void()> beside;
+  if (std::any_of(effects_.begin(), effects_.end(), [](const auto& e) { return e->afterMoveBesideMotion(); })) {
+    beside = [&] {
+      Clock::time_point mine = Clock::now();
+      for (std::size_t i = 0; i < effects_.size(); ++i) {
+        if (!effects_[i]->afterMoveBesideMotion()) continue;
+        effects_[i]->afterMove(ctx);
+        effectSeconds_[i] += since(mine);
+      }
+    };
+  }
+  kernel_->move(ctx, beside);
   motionSeconds_ += since(t);
   for (std::size_t i = 0; i < effects_.size(); ++i) {
+    if (effects_[i]->afterMoveBesideMotion()) continue;
     effects_[i]->afterMove(ctx);
     effectSeconds_[i] += since(t);
   }
