@@ -7,6 +7,8 @@
 /// Blended values are rounded to float, the precision the database stores frames in.
 
 #include <cstdint>
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -54,16 +56,45 @@ class StepVelocityField {
 class StepFields {
  public:
   void invalidate() { built_[0] = built_[1] = false; }
-  /// u_P^rec (useGas false) or u_G^rec of the sampler's frames.
+  /// u_P^rec (useGas false) or u_G^rec of the sampler's frames: the one built ahead for these frames,
+  /// if any, else built now.
   const StepVelocityField& velocity(const FrameSampler& sampler, bool useGas, bool parallel) {
     const int k = useGas ? 1 : 0;
-    if (!built_[k]) fields_[k].build(sampler, useGas, parallel), built_[k] = true;
+    if (!built_[k]) {
+      Ahead& a = ahead_[k];
+      if (a.frame && a.frame.get() == &sampler.frame() && a.next.get() == sampler.nextFrame() &&
+          a.blend == sampler.blend()) {
+        std::swap(fields_[k], a.field);  // the same build(), done earlier
+      } else {
+        fields_[k].build(sampler, useGas, parallel);
+      }
+      a.frame.reset(), a.next.reset();
+      built_[k] = true;
+    }
     return fields_[k];
+  }
+  /// Builds the field of a later step's frames now, on the calling thread (beside the motion of the
+  /// current step, which reads only the current fields); velocity() takes it when that step comes
+  /// with the same frames. Holds the frames until then.
+  void buildAhead(const CartesianGrid& grid, std::shared_ptr<const FieldFrame> frame,
+                  std::shared_ptr<const FieldFrame> next, double blend, bool useGas) {
+    Ahead& a = ahead_[useGas ? 1 : 0];
+    const FrameSampler sampler(grid, frame.get(), next.get(), blend);
+    a.field.build(sampler, useGas, false);
+    a.frame = std::move(frame);
+    a.next = sampler.nextFrame() ? std::move(next) : nullptr;
+    a.blend = sampler.blend();
   }
 
  private:
+  struct Ahead {
+    std::shared_ptr<const FieldFrame> frame, next;  ///< the frames `field` was built from (null: none)
+    double blend = 0.0;
+    StepVelocityField field;
+  };
   StepVelocityField fields_[2];
   bool built_[2] = {false, false};
+  Ahead ahead_[2];
 };
 
 /// u at single points of a step field, with the motion kernel's block arithmetic

@@ -160,15 +160,25 @@ void TracerSimulation::step() {
     effects_[i]->beforeMove(ctx);
     effectSeconds_[i] += since(t);
   }
-  // The effects whose afterMove() does not depend on the move run beside it, timed on their thread.
+  // Beside the move, on one thread: the effects whose afterMove() does not depend on it (timed on that
+  // thread), and the next step's u_P^rec step field, which the move would otherwise wait for.
   std::function<void()> beside;
-  if (std::any_of(effects_.begin(), effects_.end(), [](const auto& e) { return e->afterMoveBesideMotion(); })) {
+  const bool buildAhead = kernel_->settings().transport && ctx.step + 1 < settings_.steps;
+  if (buildAhead ||
+      std::any_of(effects_.begin(), effects_.end(), [](const auto& e) { return e->afterMoveBesideMotion(); })) {
     beside = [&] {
       Clock::time_point mine = Clock::now();
       for (std::size_t i = 0; i < effects_.size(); ++i) {
         if (!effects_[i]->afterMoveBesideMotion()) continue;
         effects_[i]->afterMove(ctx);
         effectSeconds_[i] += since(mine);
+      }
+      if (buildAhead) {
+        int frame = 0, next = 0;
+        double blend = 0.0;
+        frameAt(ctx.step + 1, frame, next, blend);
+        ctx.stepFields.buildAhead(ctx.grid, database_->frame(frame), blend > 0.0 ? database_->frame(next) : nullptr,
+                                  blend, false);
       }
     };
   }
