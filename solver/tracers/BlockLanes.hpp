@@ -76,6 +76,21 @@ inline int lanesWithSubstepsLeft(const Lanes& lanes, std::int32_t* out) {
   return r;
 }
 
+/// The number of lanes with sub-steps left.
+inline int countLanesWithSubstepsLeft(const Lanes& lanes) {
+  const std::int32_t* const left = lanes.left;
+  std::int32_t r = 0;
+#pragma omp simd reduction(+ : r)
+  for (int k = 0; k < lanes.count; ++k) r += left[k] > 0 ? 1 : 0;
+  return r;
+}
+
+/// A block whose lanes with sub-steps left after their first are at least this many takes those
+/// sub-steps in place (MotionKernel::advanceInPlace()), every lane in every round; fewer are deferred.
+/// Break-even: a deferred lane costs its copies (about 9 ns) plus its share of a full round, a
+/// round in place about as much as 64 lanes' rounds; in the benchmark's spout every lane has one.
+constexpr int kInPlaceLanes = 32;
+
 /// Lanes, from the blocks of one chunk, with sub-steps left after their first: moved together when the
 /// storage is full or the chunk ends, so later sub-steps run on full vectors rather than on the one or
 /// two lanes a block has (each round has a fixed cost: in the benchmark 2.2% of the tracers took 19%

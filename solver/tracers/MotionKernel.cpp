@@ -156,6 +156,7 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   const CounterRngPrefix rngPrefix(ctx.seed, RngPurpose::Fluctuation, std::uint64_t(ctx.step));
   const std::int64_t n = std::int64_t(cloud.size());
   std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0, scalarPath = 0, exactWallTests = 0;
+  std::int64_t blocksInPlace = 0;
   // Sub-steps so that no sub-step moves farther than max_courant cells; a non-finite or enormous
   // displacement gets kMaxSubsteps (the exact wall tests still keep the tracer inside).
   const double inverseCellLimit = 1.0 / (settings_.maxCourant * minSpacing_);
@@ -275,7 +276,7 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   // out of the parallel region, which it must not leave).
   std::exception_ptr besideFailure;
 #pragma omp parallel if (n > kParallelThreshold) \
-    reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests)
+    reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests, blocksInPlace)
   {
   if (beside && omp_get_thread_num() == omp_get_num_threads() - 1) {
     try {
@@ -383,9 +384,12 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
         };
         const bool more = countSubsteps(L) > 0;
         subStep(L, stencils, true, bc, st);
+        // The later sub-steps: in place when most lanes take them, else deferred.
+        const bool inPlace = more && countLanesWithSubstepsLeft(L) >= kInPlaceLanes;
+        if (inPlace) advanceInPlace(L, stencils, bc, st), ++st.blocksInPlace;
         // Copied back before deferring: deferring may finish lanes, whose results must not be overwritten.
         if (freeLanes > 0) putBack(L, compact);
-        if (more) defer(L, i0, freeLanes > 0 ? compact.lane : nullptr, deferred, false, stencils, bc, st);
+        if (more && !inPlace) defer(L, i0, freeLanes > 0 ? compact.lane : nullptr, deferred, false, stencils, bc, st);
         if (freeLanes > 0) {
           // Free flight: the tracers' own velocities, sub-stepped by them.
           LaneStorage fs;
@@ -405,7 +409,7 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
       indexer.cellsOf(int(last - first), px + first, py + first, pz + first, nextCells + first);
     }
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
-    scalarPath += st.scalarPath, exactWallTests += st.exactWallTests;
+    scalarPath += st.scalarPath, exactWallTests += st.exactWallTests, blocksInPlace += st.blocksInPlace;
   }
   }
   if (besideFailure) std::rethrow_exception(besideFailure);
@@ -416,6 +420,7 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   stats_.substepCapped = capped;
   stats_.scalarPath = scalarPath;
   stats_.exactWallTests = exactWallTests;
+  stats_.blocksInPlace = blocksInPlace;
 }
 
 }  // namespace rcfd

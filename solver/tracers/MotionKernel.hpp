@@ -30,6 +30,7 @@ struct MotionStatistics {
   std::int64_t substepCapped = 0;   ///< tracers that needed more than kMaxSubsteps
   std::int64_t scalarPath = 0;      ///< tracers moved one by one (free flight, or the block path off)
   std::int64_t exactWallTests = 0;  ///< block-path sub-steps that needed the exact segment test
+  std::int64_t blocksInPlace = 0;   ///< blocks whose later sub-steps ran in place (advanceInPlace())
 };
 
 class MotionKernel {
@@ -59,6 +60,11 @@ class MotionKernel {
   /// The sub-steps after the first of lanes: rounds on the lanes that still have some, compacted.
   void advanceLanes(block::Lanes& lanes, std::int32_t maxLeft, block::BlockStencils& stencils, bool freeFlying,
                     const block::Context& bc, MotionStatistics& st) const;
+  /// The sub-steps after the first of the lanes of a block in place, when most of its lanes have some
+  /// (in the spout every lane does): rounds over the whole block, in which the lanes without sub-steps
+  /// left stand still (a zero sub-step) and keep their velocity. Spares the copies of defer().
+  void advanceInPlace(block::Lanes& lanes, block::BlockStencils& stencils, const block::Context& bc,
+                      MotionStatistics& st) const;
   /// Adds the lanes with sub-steps left (lane k is tracer i0 + k, or i0 + laneOf[k]) to `deferred`,
   /// finishing its lanes whenever it is full.
   void defer(const block::Lanes& lanes, std::int64_t i0, const std::int32_t* laneOf, block::DeferredLanes& deferred,

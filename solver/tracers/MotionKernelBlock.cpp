@@ -152,7 +152,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   // The rest meet a wall or pass close to one: the exact segment test and mirror reflection, which
   // for a free-flying tracer also reflects its velocity with the restitution coefficient.
   for (int k = 0; k < m; ++k) {
-    if (fast[k]) continue;
+    if (fast[k] || h[k] == 0.0) continue;  // h = 0: a lane standing still in advanceInPlace()
     Eigen::Vector3d p(x[k], y[k], z[k]);
     Eigen::Vector3d u(ux[k], uy[k], uz[k]);
     st.wallHits += moveWithWalls(p, h[k] * u, freeFlying ? &u : nullptr, bc.restitution);
@@ -221,6 +221,36 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
       const int k = rs.lane[j];
       L.x[k] = R.x[j], L.y[k] = R.y[j], L.z[k] = R.z[j];
       L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
+    }
+  }
+}
+
+void MotionKernel::advanceInPlace(block::Lanes& L, block::BlockStencils& s, const block::Context& bc,
+                                  MotionStatistics& st) const {
+  const int m = L.count;
+  alignas(64) double h[kBlock], ux[kBlock], uy[kBlock], uz[kBlock];
+  alignas(64) std::int32_t none[kBlock];
+  alignas(64) std::int32_t on[kBlock];
+  Lanes all = L;
+  all.h = h, all.ux = ux, all.uy = uy, all.uz = uz, all.left = none;
+  all.cell = nullptr, all.reach = nullptr;  // the cells are not known after the first sub-step
+  for (;;) {
+    std::int32_t active = 0;
+#pragma omp simd reduction(+ : active)
+    for (int k = 0; k < m; ++k) {
+      on[k] = L.left[k] > 0 ? 1 : 0;
+      h[k] = on[k] != 0 ? L.h[k] : 0.0;  // x + 0 u = x: a lane without sub-steps left stands still
+      L.left[k] -= on[k];
+      none[k] = 0;
+      active += on[k];
+    }
+    if (active == 0) return;
+    subStep(all, s, false, bc, st);
+#pragma omp simd
+    for (int k = 0; k < m; ++k) {
+      L.ux[k] = on[k] != 0 ? ux[k] : L.ux[k];
+      L.uy[k] = on[k] != 0 ? uy[k] : L.uy[k];
+      L.uz[k] = on[k] != 0 ? uz[k] : L.uz[k];
     }
   }
 }

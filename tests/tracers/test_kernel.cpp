@@ -223,7 +223,9 @@ namespace {
 /// blocks into free flight (drag toward u_G^rec, gravity, restitution at the walls).
 /// With `plates`, the same flow runs through the ProCell prism with draft plates (V walls, plates), so
 /// the vectorised wall test meets inclined walls and the plates' distance bound.
-void expectBlockPathMatchesScalarPath(bool freeFlight, bool plates = false) {
+/// With `speed` above 1 the flow is that many times faster: at 3, most tracers take two or more
+/// sub-steps, so most blocks take them in place (MotionKernel::advanceInPlace()) and the rest defer them.
+void expectBlockPathMatchesScalarPath(bool freeFlight, bool plates = false, double speed = 1.0) {
   std::vector<std::string> effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
   if (freeFlight) effects.push_back("free_flight");
   Scene s = boxScene({0.2, 0.2, 0.2}, 0.01, 6000, 0.005, effects);
@@ -238,12 +240,12 @@ void expectBlockPathMatchesScalarPath(bool freeFlight, bool plates = false) {
   // spans x in [-w/2, w/2], y and z from 0), so tracers stay spread and only the fluctuation and the
   // corners of the cells bring them to the walls; 2.2 m/s peaks (1.1 cells per step) are sub-stepped.
   const double alphaMin = freeFlight ? -0.1 : 0.05;  // below 0.02 in stripes when free flight is on
-  auto db = database(s, 6, s.rcfd.dt, [grid, alphaMin](int n, double t, FieldFrame& f) {
+  auto db = database(s, 6, s.rcfd.dt, [grid, alphaMin, speed](int n, double t, FieldFrame& f) {
     for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
       const auto ijk = grid.cellIjk(c);
       const auto p = grid.cellCenter(ijk[0], ijk[1], ijk[2]);
       const double X = std::numbers::pi * (p.x() + 0.1) / 0.2, Y = std::numbers::pi * p.y() / 0.2;
-      const double U = 2.2 * (1.0 + 0.05 * std::sin(3 * t + n));
+      const double U = speed * 2.2 * (1.0 + 0.05 * std::sin(3 * t + n));
       const double alpha = alphaMin + 0.25 + 0.25 * std::sin(40 * p.x() + 3 * t);
       f.alpha_p[std::size_t(c)] = float(std::max(alpha, 0.0));
       f.u_p[3 * c] = float(U * std::sin(X) * std::cos(Y));
@@ -256,12 +258,13 @@ void expectBlockPathMatchesScalarPath(bool freeFlight, bool plates = false) {
   TracerSimulation block(s, db, sequentialPath(6, steps + 2), {5, steps, 0, true});
   TracerSimulation scalar(s, db, sequentialPath(6, steps + 2), {5, steps, 0, false});
   std::int64_t scalarPathTracers = 0, exactWallTests = 0, wallHits = 0, substeps = 0, freeFlying = 0;
+  std::int64_t blocksInPlace = 0;
   for (std::int64_t k = 0; k < steps; ++k) {
     block.step();
     scalar.step();
     const MotionStatistics& b = block.motionStatistics();
     scalarPathTracers += b.scalarPath, exactWallTests += b.exactWallTests, wallHits += b.wallHits;
-    substeps += b.substeps, freeFlying += b.freeFlight;
+    substeps += b.substeps, freeFlying += b.freeFlight, blocksInPlace += b.blocksInPlace;
     EXPECT_EQ(b.scalarPath, 0);  // the block path moves everything, free flight included
     EXPECT_EQ(scalar.motionStatistics().scalarPath, std::int64_t(s.rcfd.tracers));
     EXPECT_EQ(scalar.motionStatistics().substeps, b.substeps);
@@ -277,6 +280,12 @@ void expectBlockPathMatchesScalarPath(bool freeFlight, bool plates = false) {
     EXPECT_LT(freeFlying, steps * s.rcfd.tracers / 2);
   }
   EXPECT_EQ(scalarPathTracers, 0);
+  const std::int64_t blocks = steps * ((s.rcfd.tracers + 63) / 64);
+  if (speed > 2.0) {
+    EXPECT_GT(blocksInPlace, blocks / 2);
+  } else {
+    EXPECT_LT(blocksInPlace, blocks / 10);  // the slow flow defers its few sub-steps
+  }
   double worst = 0.0;
   for (std::size_t i = 0; i < block.cloud().size(); ++i) {
     worst = std::max(worst, (block.cloud().position(i) - scalar.cloud().position(i)).cwiseAbs().maxCoeff());
@@ -288,6 +297,12 @@ void expectBlockPathMatchesScalarPath(bool freeFlight, bool plates = false) {
 TEST(Kernel, BlockPathMatchesScalarPath) { expectBlockPathMatchesScalarPath(false); }
 
 TEST(Kernel, BlockPathMatchesScalarPathWithFreeFlightLanes) { expectBlockPathMatchesScalarPath(true); }
+
+TEST(Kernel, BlockPathMatchesScalarPathWithSubstepsInPlace) { expectBlockPathMatchesScalarPath(false, false, 3.0); }
+
+TEST(Kernel, BlockPathMatchesScalarPathWithSubstepsInPlaceAndFreeFlight) {
+  expectBlockPathMatchesScalarPath(true, false, 3.0);
+}
 
 TEST(Kernel, BlockPathMatchesScalarPathInThePrismWithDraftPlates) { expectBlockPathMatchesScalarPath(false, true); }
 
