@@ -229,10 +229,9 @@ void MotionKernel::advanceInPlace(block::Lanes& L, block::BlockStencils& s, cons
                                   MotionStatistics& st) const {
   const int m = L.count;
   alignas(64) double h[kBlock], ux[kBlock], uy[kBlock], uz[kBlock];
-  alignas(64) std::int32_t none[kBlock];
   alignas(64) std::int32_t on[kBlock];
   Lanes all = L;
-  all.h = h, all.ux = ux, all.uy = uy, all.uz = uz, all.left = none;
+  all.h = h, all.ux = ux, all.uy = uy, all.uz = uz;  // a round reads no `left`
   all.cell = nullptr, all.reach = nullptr;  // the cells are not known after the first sub-step
   for (;;) {
     std::int32_t active = 0;
@@ -241,7 +240,6 @@ void MotionKernel::advanceInPlace(block::Lanes& L, block::BlockStencils& s, cons
       on[k] = L.left[k] > 0 ? 1 : 0;
       h[k] = on[k] != 0 ? L.h[k] : 0.0;  // x + 0 u = x: a lane without sub-steps left stands still
       L.left[k] -= on[k];
-      none[k] = 0;
       active += on[k];
     }
     if (active == 0) return;
