@@ -1,16 +1,24 @@
 #pragma once
 // The paper-scale tracer case shared by `rcfd-bench tracers` and `rcfd-bench spray`: the ProCell
 // apparatus (250 x 600 x 200 mm) on 7.4 mm cells (34 x 81 x 27 = 74,358 cells, the paper's 73,647
-// within 1%), 472,850 tracers, 100 in-memory frames of the swaying spout (SyntheticFields.hpp),
-// dt = dt_rec = 5 ms. --quick: 15 mm cells, 47,285 tracers, 10 frames.
+// within 1%), 472,850 tracers, 100 in-memory frames of a circulating spouted bed (CirculatingBed.hpp;
+// until 2026-12-03 the swaying spout of SyntheticFields.hpp, still selected by
+// RCFD_BENCH_FIELD=swaying_spout for comparisons with older figures), dt = dt_rec = 5 ms.
+// --quick: 15 mm cells, 47,285 tracers, 10 frames.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <utility>
+#include <vector>
 #include <cstdlib>
 #include <string>
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 
 #include "BenchRegistry.hpp"
+#include "CirculatingBed.hpp"
 #include "SyntheticFields.hpp"
 #include "fields/AnalyticDatabase.hpp"
 #include "geometry/Apparatus.hpp"
@@ -24,10 +32,40 @@ inline double processCpuSeconds() {
   return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
+/// What makes a field database costly to move tracers through, weighted by solids volume (alpha_P x
+/// open volume) over all frames: the fraction of the solids moving more than one cell per step (they
+/// need sub-steps), faster than 1 m/s, their mean speed, and the fractions in dense (alpha_P > 0.45)
+/// and dilute (alpha_P < 0.2) cells. For comparison, the quick example's CFD-DEM database (2026-12-03):
+/// 0.074, 0.187, 0.58 m/s, 0.33 and 0.40 (docs/performance.md).
+inline nlohmann::json fieldStatistics(const FieldDatabase& db, double dt) {
+  const CartesianGrid& g = db.grid();
+  const double oneCellPerStep = g.spacing.minCoeff() / dt;
+  double solids = 0.0, fast = 0.0, overOne = 0.0, speed = 0.0, dense = 0.0, dilute = 0.0;
+  for (int n = 0; n < db.frameCount(); ++n) {
+    const auto f = db.frame(n);
+    for (std::size_t c = 0; c < std::size_t(g.cellCount()); ++c) {
+      const double a = f->alpha_p[c], w = a * double(db.fluidFraction()[c]);
+      const double u = std::sqrt(double(f->u_p[3 * c]) * f->u_p[3 * c] + double(f->u_p[3 * c + 1]) * f->u_p[3 * c + 1] +
+                                 double(f->u_p[3 * c + 2]) * f->u_p[3 * c + 2]);
+      solids += w, speed += w * u;
+      if (u > oneCellPerStep) fast += w;
+      if (u > 1.0) overOne += w;
+      if (a > 0.45) dense += w;
+      if (a < 0.2) dilute += w;
+    }
+  }
+  if (!(solids > 0.0)) return nlohmann::json::object();
+  return {{"solids_over_one_cell_per_step", fast / solids}, {"solids_over_1_m_per_s", overOne / solids},
+          {"mean_solids_speed", speed / solids}, {"solids_in_alpha_over_0.45", dense / solids},
+          {"solids_in_alpha_under_0.2", dilute / solids}};
+}
+
 struct TracerBenchCase {
   Scene scene;  // ProCell defaults
   std::shared_ptr<FieldDatabase> db;
   std::int64_t cells = 0;
+  std::string field = "circulating_bed";  ///< RCFD_BENCH_FIELD: circulating_bed or swaying_spout
+  nlohmann::json statistics;              ///< fieldStatistics() of the database
 
   explicit TracerBenchCase(const Options& options) {
     const double cell = options.quick ? 0.015 : 0.0074;  // 0.0074 m -> about 74k cells
@@ -44,8 +82,20 @@ struct TracerBenchCase {
     cells = grid.cellCount();
     std::cerr << "grid " << grid.shape[0] << " x " << grid.shape[1] << " x " << grid.shape[2] << " = "
               << grid.cellCount() << " cells, " << scene.rcfd.tracers << " tracers, " << frames << " frames\n";
-    db = makeAnalyticDatabase(grid, fluid, scene.rcfd.dt, frames,
-                              [&](int n, double t, FieldFrame& f) { swayingSpout(grid, n, t, f); });
+    if (const char* e = std::getenv("RCFD_BENCH_FIELD")) field = e;
+    if (field == "swaying_spout") {
+      db = makeAnalyticDatabase(grid, fluid, scene.rcfd.dt, frames,
+                                [&](int n, double t, FieldFrame& f) { swayingSpout(grid, n, t, f); });
+    } else if (field == "circulating_bed") {
+      const CirculatingBed bed(scene, grid, fluid);
+      std::cerr << "circulating bed: bed height " << bed.bedHeight() << " m\n";
+      db = makeAnalyticDatabase(grid, fluid, scene.rcfd.dt, frames,
+                                [&](int n, double t, FieldFrame& f) { bed(n, t, f); });
+    } else {
+      throw std::invalid_argument("RCFD_BENCH_FIELD: '" + field + "' is neither circulating_bed nor swaying_spout");
+    }
+    statistics = fieldStatistics(*db, scene.rcfd.dt);
+    std::cerr << field << ": " << statistics.dump() << "\n";
   }
 };
 
@@ -60,7 +110,31 @@ struct Timing {
   double wallTestFraction = 0.0;   ///< block-path sub-steps that needed the exact wall test, per tracer-step (mean)
   double freeFlightFraction = 0.0; ///< tracer-steps in free flight (mean)
   nlohmann::json stageMsPerStep = nlohmann::json::object();  ///< TracerSimulation::stageSeconds() per step [ms]
+  /// How the tracers are spread at the end (cells occupied, alpha_P of the tracers): a case whose
+  /// tracers collapse into a few cells times a kernel that reads the same few cells (see CirculatingBed).
+  nlohmann::json tracerSpread = nlohmann::json::object();
 };
+
+/// Cells holding tracers and the tracers' alpha_P per cell (99th percentile by tracer, maximum) at the
+/// start of the simulation's last step; empty without `tracer_volume_fraction`.
+inline nlohmann::json tracerSpread(const TracerContext& ctx) {
+  if (ctx.tracerCount.empty() || ctx.tracerAlpha.size() != ctx.tracerCount.size()) return nlohmann::json::object();
+  std::vector<std::pair<float, std::int32_t>> occupied;  // (alpha_P of the tracers, tracers) per occupied cell
+  for (std::size_t c = 0; c < ctx.tracerCount.size(); ++c) {
+    if (ctx.tracerCount[c] > 0) occupied.emplace_back(ctx.tracerAlpha[c], ctx.tracerCount[c]);
+  }
+  if (occupied.empty()) return nlohmann::json::object();
+  std::sort(occupied.begin(), occupied.end());
+  std::int64_t total = 0;
+  for (const auto& o : occupied) total += o.second;
+  std::int64_t below = 0;
+  float p99 = occupied.back().first;
+  for (const auto& o : occupied) {
+    below += o.second;
+    if (double(below) >= 0.99 * double(total)) { p99 = o.first; break; }
+  }
+  return {{"occupied_cells", occupied.size()}, {"tracer_alpha_p99", p99}, {"tracer_alpha_max", occupied.back().first}};
+}
 
 /// One benchmark simulation, stepped and timed one step at a time (so that two configurations can be
 /// timed in alternation, step by step: the VM's speed drifts by up to 30% within minutes, and drift
@@ -100,6 +174,7 @@ class TimedRun {
     t.wallTestFraction = double(sum_.exactWallTests) / tracerSteps;
     t.freeFlightFraction = double(sum_.freeFlight) / tracerSteps;
     for (const auto& [stage, seconds] : sim_.stageSeconds()) t.stageMsPerStep[stage] = seconds / steps * 1e3;
+    t.tracerSpread = tracerSpread(std::as_const(sim_).context());
     return t;
   }
 

@@ -249,6 +249,8 @@ nlohmann::json run(const Options& options) {
   nlohmann::json out;
   out["tracers"] = n;
   out["cells"] = bench.cells;
+  out["field"] = bench.field;
+  out["field_statistics"] = bench.statistics;
   out["steps"] = steps;
   struct Variant {
     const char* name;

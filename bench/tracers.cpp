@@ -84,6 +84,9 @@ nlohmann::json runTracers(const Options& options) {
           {"exact_wall_test_fraction", headline.wallTestFraction},
           {"substep_fraction", headline.substepFraction},
           {"cells", bench.cells},
+          {"field", bench.field},
+          {"field_statistics", bench.statistics},
+          {"tracer_spread", headline.tracerSpread},
           {"stage_ms_per_step", headline.stageMsPerStep},
           {"effect_costs", costs}};
 }
