@@ -17,8 +17,8 @@
 //    the chamber's cross-section), the spout's jet decaying over 50 mm above the bed.
 // The values were chosen so that the solids move as in the quick example's CFD-DEM database
 // (fieldStatistics() in TracerBenchCase.hpp, solids-weighted over all frames; that database / this
-// field): 7.4% / 7.4% of the solids move more than one cell per step, 18.7% / 13.2% faster than 1 m/s,
-// mean speed 0.58 / 0.56 m/s, 33% / 28% in cells with alpha_P > 0.45 and 40% / 39% below 0.2.
+// field): 7.4% / 7.5% of the solids move more than one cell per step, 18.7% / 13.5% faster than 1 m/s,
+// mean speed 0.58 / 0.57 m/s, 33% / 29% in cells with alpha_P > 0.45 and 40% / 38% below 0.2.
 // A steady flux alone would leave the tracers on their streamlines, and the interpolation error of the
 // cell-centred field gathers them onto a few (stripes at 1.5x alpha_P within 2 s). So the flow is the
 // main circulation plus two more stream-function modes with zero boundary values, oscillating with
@@ -96,11 +96,14 @@ class CirculatingBed {
   double halfWidthAt(double y) const { return std::min(halfWidth_, halfInlet_ + slope_ * std::max(0.0, y)); }
   double top() const { return kTopOverBed * bedHeight_; }
 
-  /// alpha_P^rec at a cell centre; the centres of cut cells outside the chamber take the value inside.
-  double alphaAt(double x, double y) const {
+  /// alpha_P^rec of the cell centred at (x, y) with height dy; cut cells whose centre lies outside the
+  /// chamber take the value inside. The row the bed's surface crosses mixes bed and fountain by the
+  /// part of the cell below H, so the solid volume grows continuously with H.
+  double alphaAt(double x, double y, double dy) const {
     if (y > top()) return 0.0;
-    if (y > bedHeight_) return kFountainAlpha;
-    return std::abs(x) < kSpoutFraction * halfWidthAt(y) ? kSpoutAlpha : kAnnulusAlpha;
+    const double bed = std::abs(x) < kSpoutFraction * halfWidthAt(y) ? kSpoutAlpha : kAnnulusAlpha;
+    const double below = std::clamp((bedHeight_ - (y - 0.5 * dy)) / dy, 0.0, 1.0);
+    return below * bed + (1.0 - below) * kFountainAlpha;
   }
 
   /// The stream functions for a unit circulation rate, psi_m = -sign(x) A_m(xi) B_m(eta), xi = |x| / w(y),
@@ -124,7 +127,7 @@ class CirculatingBed {
     for (std::int64_t c = 0; c < grid_.cellCount(); ++c) {
       const auto ijk = grid_.cellIjk(c);
       const Eigen::Vector3d p = grid_.cellCenter(ijk[0], ijk[1], ijk[2]);
-      v += alphaAt(p.x(), p.y()) * double(open[std::size_t(c)]) * grid_.cellVolume();
+      v += alphaAt(p.x(), p.y(), grid_.spacing.y()) * double(open[std::size_t(c)]) * grid_.cellVolume();
     }
     return v;
   }
@@ -143,7 +146,7 @@ class CirculatingBed {
       const auto ijk = grid_.cellIjk(c);
       const Eigen::Vector3d p = grid_.cellCenter(ijk[0], ijk[1], ijk[2]);
       const std::size_t s = std::size_t(c);
-      const double a = alphaAt(p.x(), p.y());
+      const double a = alphaAt(p.x(), p.y(), dy);
       alpha_[s] = a;
       // The cell's mean flux from psi at its corners (central differences of the corner values).
       const double x0 = p.x() - 0.5 * dx, x1 = p.x() + 0.5 * dx, y0 = p.y() - 0.5 * dy, y1 = p.y() + 0.5 * dy;
