@@ -305,14 +305,13 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
       } else {
         indexer.cellsOf(count, px + i0, py + i0, pz + i0, cellsFound);
       }
+      // `free` is read only where freeLanes > 0 (without free_flight, zeroing it was a memset per block).
       std::int64_t freeLanes = 0;
       if (settings_.freeFlight) {
         for (int k = 0; k < count; ++k) {
           free[k] = sampler.alphaP(cellOf[k]) < settings_.freeFlightAlpha;
           freeLanes += free[k];
         }
-      } else {
-        for (int k = 0; k < count; ++k) free[k] = 0;
       }
       // A cell's reach and speed side by side: one 64-bit gather per lane for both (two 32-bit gathers
       // cost 1.7x as much on this machine).
