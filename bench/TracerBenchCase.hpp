@@ -8,14 +8,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <utility>
-#include <vector>
 #include <cstdlib>
-#include <string>
 #include <ctime>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "BenchRegistry.hpp"
 #include "CirculatingBed.hpp"

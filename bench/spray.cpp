@@ -5,7 +5,8 @@
 // configurations are timed over the same steps. Figures: simulated seconds per wall second, the
 // projected wall time of 1 h of process, and the spray stage's cost relative to the tracer step.
 // RCFD_BENCH_INTEGRATOR=euler|midpoint overrides the scene's integrator (an accuracy knob, as in
-// `rcfd-bench tracers`); RCFD_BENCH_TRACERS the tracer count, RCFD_BENCH_STEPS the timed steps.
+// `rcfd-bench tracers`); RCFD_BENCH_TRACERS the tracer count, RCFD_BENCH_STEPS the timed steps,
+// RCFD_BENCH_FIELD=swaying_spout the field before 2026-12-03 (TracerBenchCase.hpp).
 // RCFD_BENCH_SPRAY_ONLY=1 times the spray configuration alone (no tracer-only twin, no overhead
 // figures), with progress on stderr every 1% of the steps: for long runs that measure the goal
 // directly, e.g. RCFD_BENCH_STEPS=720000 is 1 h of process, which averages over the VM's phases.
