@@ -12,7 +12,9 @@
 // `midpoint_float` prices the midpoint floor with the lanes' arithmetic in float (positions stay double;
 // grid coordinates, velocities and displacements are float, so a vector holds 16 lanes instead of 8);
 // since 2026-12-03 the kernel locates and takes midpoints in float grid coordinates as it does, with the
-// same functions, and keeps its displacements in double. `midpoint_gradient` prices a one-sample second-order step
+// same functions, and keeps its displacements in double. `midpoint_float_fluctuation_next_cells` adds
+// the Eq. (10) direction in float (counterUnitVectorFloat(), as the kernel) and the next cells to it: the
+// floor of the kernel's own arithmetic, which no walls and no sub-steps can undercut. `midpoint_gradient` prices a one-sample second-order step
 // (floorStepGradient()); `error_against_16_substeps` gives the position error of one step of each against a reference.
 #include <algorithm>
 #include <bit>
@@ -115,9 +117,17 @@ void floorStep(const FloorCase& c, int samples, FloorParts parts, const CounterR
   }
 }
 
+/// u += u_fluc for the lanes of a block, in float (the kernel adds it in sampleBlockFloat()).
+inline void addFluctuation(int m, const float* ax, const float* ay, const float* az, float* ux, float* uy, float* uz) {
+#pragma omp simd
+  for (int k = 0; k < m; ++k) ux[k] += ax[k], uy[k] += ay[k], uz[k] += az[k];
+}
+
 /// The midpoint floor with float lanes: grid coordinates from the double positions once, the midpoint
-/// and the displacement in float, the positions updated in double.
-void floorStepFloat(const FloorCase& c) {
+/// and the displacement in float, the positions updated in double. With `parts`, the kernel's Eq. (10)
+/// in float (counterUnitVectorFloat() times the cell's speed, added to both samples) and the next cells:
+/// the floor of the kernel's own arithmetic, with no walls and no sub-steps.
+void floorStepFloat(const FloorCase& c, FloorParts parts, const CounterRngPrefix& prefix) {
   const std::int64_t blocks = (c.n + kBlock - 1) / kBlock;
   constexpr std::int64_t kChunk = 16;
   const block::GridConstants grid(c.q);
@@ -128,21 +138,37 @@ void floorStepFloat(const FloorCase& c) {
     block::BlockStencils s;
     alignas(64) float gx[kBlock], gy[kBlock], gz[kBlock], mx[kBlock], my[kBlock], mz[kBlock];
     alignas(64) float ux[kBlock], uy[kBlock], uz[kBlock];
+    alignas(64) float ax[kBlock] = {}, ay[kBlock] = {}, az[kBlock] = {};
     for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
       const std::int64_t i0 = b * kBlock;
       const int m = int(std::min<std::int64_t>(kBlock, c.n - i0));
+      if (parts.fluctuation) {
+        const CounterRngPrefix rng = prefix;
+        const float* const speedOf = c.speed;
+        const std::int32_t* const ids = c.ids + i0;
+        const std::int32_t* const cellOf = c.cell + i0;
+#pragma omp simd
+        for (int k = 0; k < m; ++k) {
+          const float speed = speedOf[cellOf[k]];
+          float nx, ny, nz;
+          counterUnitVectorFloat(rng, std::uint64_t(ids[k]), nx, ny, nz);
+          ax[k] = speed * nx, ay[k] = speed * ny, az[k] = speed * nz;
+        }
+      }
       const double* x = c.x + i0;
       const double* y = c.y + i0;
       const double* z = c.z + i0;
       block::gridCoordinatesOfBlock(grid, m, x, y, z, gx, gy, gz);
       block::locateGridBlock(grid, m, gx, gy, gz, s);
       block::sampleBlock3(c.field, c.corners, s, m, ux, uy, uz);
+      if (parts.fluctuation) addFluctuation(m, ax, ay, az, ux, uy, uz);
 #pragma omp simd
       for (int k = 0; k < m; ++k) {
         mx[k] = gx[k] + half * ux[k] * fix, my[k] = gy[k] + half * uy[k] * fiy, mz[k] = gz[k] + half * uz[k] * fiz;
       }
       block::locateGridBlock(grid, m, mx, my, mz, s);
       block::sampleBlock3(c.field, c.corners, s, m, ux, uy, uz);
+      if (parts.fluctuation) addFluctuation(m, ax, ay, az, ux, uy, uz);
       double* outX = c.outX + i0;
       double* outY = c.outY + i0;
       double* outZ = c.outZ + i0;
@@ -150,6 +176,10 @@ void floorStepFloat(const FloorCase& c) {
       for (int k = 0; k < m; ++k) {
         outX[k] = x[k] + double(dt * ux[k]), outY[k] = y[k] + double(dt * uy[k]), outZ[k] = z[k] + double(dt * uz[k]);
       }
+    }
+    if (parts.nextCells) {
+      const std::int64_t first = chunk * kChunk * kBlock, last = std::min(c.n, (chunk + 1) * kChunk * kBlock);
+      c.indexer->cellsOf(int(last - first), c.outX + first, c.outY + first, c.outZ + first, c.nextCell + first);
     }
   }
 }
@@ -263,10 +293,11 @@ nlohmann::json run(const Options& options) {
                               {"midpoint_next_cells", 2, {false, true}},
                               {"midpoint_fluctuation_next_cells", 2, {true, true}},
                               {"midpoint_float", 0, {}},
+                              {"midpoint_float_fluctuation_next_cells", 0, {true, true}},
                               {"midpoint_gradient", -1, {}}};
   auto stepOf = [&](const Variant& v) {
     if (v.samples == 0) {
-      floorStepFloat(c);
+      floorStepFloat(c, v.parts, prefix);
     } else if (v.samples < 0) {
       floorStepGradient(c);
     } else {
