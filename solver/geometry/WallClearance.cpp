@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <stdexcept>
 
 namespace rcfd {
 
@@ -15,6 +16,26 @@ std::vector<float> cellWallClearance(const Apparatus& apparatus, const Cartesian
     clearance[std::size_t(c)] = float(std::max(0.0, sd - margin) * (1.0 - 1e-6));
   }
   return clearance;
+}
+
+std::vector<std::uint8_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfSpace>& halfSpaces,
+                                              const CartesianGrid& grid, double margin, double reach) {
+  if (halfSpaces.size() > 8) throw std::invalid_argument("nearHalfSpaceMasks: more than 8 half-spaces");
+  const double halfDiagonal = 0.5 * grid.spacing.norm();
+  const double slack = 1e-6 * grid.spacing.minCoeff();
+  const double within = margin + halfDiagonal + reach + slack;
+  std::vector<std::uint8_t> masks(std::size_t(grid.cellCount()));
+#pragma omp parallel for schedule(static) if (grid.cellCount() > 4096)
+  for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+    const auto ijk = grid.cellIjk(c);
+    const Eigen::Vector3d centre = grid.cellCenter(ijk[0], ijk[1], ijk[2]);
+    unsigned mask = 0;
+    for (std::size_t j = 0; j < halfSpaces.size(); ++j) {
+      if (!(halfSpaces[j].n.dot(centre) - halfSpaces[j].c >= within)) mask |= 1u << j;
+    }
+    masks[std::size_t(c)] = std::uint8_t(mask);
+  }
+  return masks;
 }
 
 }  // namespace rcfd

@@ -117,6 +117,10 @@ struct Context {
   int halfSpaces = 0;               ///< 0: no half-space test (walls off, or an outline too complex)
   double hx[kMaxHalfSpaces] = {}, hy[kMaxHalfSpaces] = {}, hz[kMaxHalfSpaces] = {}, hc[kMaxHalfSpaces] = {};
   double margin = 0.0;              ///< 2 boundaryTolerance() [m]
+  /// Per cell, the half-spaces a move of at most sqrt(nearReach2) from it may come within `margin` of
+  /// (nearHalfSpaceMasks()); null: test them all
+  const std::uint8_t* nearHalfSpaces = nullptr;
+  double nearReach2 = 0.0;          ///< [m2]
   double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
   double halfDiagonal = 0.0;        ///< half a cell diagonal: no point of a cell is farther from its centre [m]
   static constexpr int kMaxSubsteps = 64;  ///< MotionKernel::kMaxSubsteps

@@ -46,6 +46,14 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
     clearance_ = cellWallClearance(apparatus_, grid_, halfDiagonal);
     reach_ = cellWallClearance(apparatus_, grid_, band);
     halfSpaces_ = apparatus_.convexHalfSpaces();
+    // Which half-spaces the block path's second wall test needs per cell: a cell near a z wall need not
+    // test the outline's six planes, a cell at a V wall not the z walls. Moves of up to 1.5 cells (the
+    // Courant limit's sub-steps, with room for the midpoint velocity) read their cell's mask; longer
+    // ones test every plane.
+    if (halfSpaces_.size() <= 8) {  // the prism's and the box's outlines: 8 and 6
+      nearReach_ = 1.5 * grid_.spacing.minCoeff();
+      nearHalfSpaces_ = nearHalfSpaceMasks(halfSpaces_, grid_, 2.0 * apparatus_.boundaryTolerance(), nearReach_);
+    }
     // Distance from each cell centre to the draft plates less the band: a move with
     // |p - centre| + |disp| below it cannot reach a plate (the block path's second wall test).
     const auto& holes = apparatus_.holes();
@@ -200,6 +208,7 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
       bc.hx[j] = hs.n.x(), bc.hy[j] = hs.n.y(), bc.hz[j] = hs.n.z(), bc.hc[j] = hs.c;
     }
     bc.margin = 2.0 * apparatus_.boundaryTolerance();
+    if (!nearHalfSpaces_.empty()) bc.nearHalfSpaces = nearHalfSpaces_.data(), bc.nearReach2 = nearReach_ * nearReach_;
   }
 
   // The scalar path: free flight, and every tracer when the block path is off (tests compare both).

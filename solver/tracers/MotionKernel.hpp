@@ -89,6 +89,9 @@ class MotionKernel {
   std::vector<float> reach_;      ///< wall distance of each cell centre less the hit band [m]
   std::vector<float> plateReach_; ///< draft-plate distance of each cell centre less the band [m] (plates only)
   std::vector<Apparatus::HalfSpace> halfSpaces_;  ///< the open region's convex part
+  /// Per cell, the half-spaces a move of at most nearReach_ may come near (nearHalfSpaceMasks())
+  std::vector<std::uint8_t> nearHalfSpaces_;
+  double nearReach_ = 0.0;        ///< [m]
   double minSpacing_;
   double inverseStokesTime_;      ///< 18 rho_G nu_G / (rho_P d_P^2) [1/s]
   double reynoldsPerSpeed_;       ///< d_P / nu_G [s/m]

@@ -2,7 +2,9 @@
 // compiler vectorises, with the scalar path's arithmetic (MotionKernel.cpp), so both give the same
 // trajectories.
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #if defined(__AVX2__)
 #include <immintrin.h>
@@ -115,7 +117,21 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
 #pragma omp simd
       for (int k = 0; k < m; ++k) inside[k] = 1;
     }
-    for (int j = 0; j < bc.halfSpaces; ++j) {
+    // Only the planes some pending lane's cell is near (a lane moving farther than nearReach needs all):
+    // a plane left out would have passed (nearHalfSpaceMasks()), so the decisions are those of testing all.
+    const std::uint32_t all = (std::uint32_t(1) << bc.halfSpaces) - 1;
+    std::uint32_t planes = all;
+    if (const std::uint8_t* near = bc.nearHalfSpaces) {
+      const double nearReach2 = bc.nearReach2;
+      planes = 0;
+#pragma omp simd reduction(| : planes)
+      for (int k = 0; k < m; ++k) {
+        const std::uint32_t lane = length2[k] <= nearReach2 ? std::uint32_t(near[cell[k]]) : all;
+        planes |= fast[k] != 0 ? 0u : lane;
+      }
+    }
+    for (; planes != 0; planes &= planes - 1) {
+      const int j = std::countr_zero(planes);
       const double nx = bc.hx[j], ny = bc.hy[j], nz = bc.hz[j], c = bc.hc[j];
 #pragma omp simd
       for (int k = 0; k < m; ++k) inside[k] &= std::int64_t(nx * ex[k] + ny * ey[k] + nz * ez[k] - c >= margin);
