@@ -14,8 +14,9 @@
 // since 2026-12-03 the kernel locates and takes midpoints in float grid coordinates as it does, with the
 // same functions, and keeps its displacements in double. `midpoint_float_fluctuation_next_cells` adds
 // the Eq. (10) direction in float (counterUnitVectorFloat(), as the kernel) and the next cells to it: the
-// floor of the kernel's own arithmetic, which no walls and no sub-steps can undercut. `midpoint_gradient` prices a one-sample second-order step
-// (floorStepGradient()); `error_against_16_substeps` gives the position error of one step of each against a reference.
+// floor of the kernel's own arithmetic, which no walls and no sub-steps can undercut.
+// `midpoint_gradient` prices a one-sample second-order step (floorStepGradient());
+// `error_against_16_substeps` gives the position error of one step of each against a reference.
 #include <algorithm>
 #include <bit>
 #include <chrono>
