@@ -18,13 +18,13 @@ std::vector<float> cellWallClearance(const Apparatus& apparatus, const Cartesian
   return clearance;
 }
 
-std::vector<std::uint8_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfSpace>& halfSpaces,
+std::vector<std::uint32_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfSpace>& halfSpaces,
                                               const CartesianGrid& grid, double margin, double reach) {
-  if (halfSpaces.size() > 8) throw std::invalid_argument("nearHalfSpaceMasks: more than 8 half-spaces");
+  if (halfSpaces.size() > 32) throw std::invalid_argument("nearHalfSpaceMasks: more than 32 half-spaces");
   const double halfDiagonal = 0.5 * grid.spacing.norm();
   const double slack = 1e-6 * grid.spacing.minCoeff();
   const double within = margin + halfDiagonal + reach + slack;
-  std::vector<std::uint8_t> masks(std::size_t(grid.cellCount()));
+  std::vector<std::uint32_t> masks(std::size_t(grid.cellCount()));
 #pragma omp parallel for schedule(static) if (grid.cellCount() > 4096)
   for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
     const auto ijk = grid.cellIjk(c);
@@ -33,7 +33,7 @@ std::vector<std::uint8_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfSp
     for (std::size_t j = 0; j < halfSpaces.size(); ++j) {
       if (!(halfSpaces[j].n.dot(centre) - halfSpaces[j].c >= within)) mask |= 1u << j;
     }
-    masks[std::size_t(c)] = std::uint8_t(mask);
+    masks[std::size_t(c)] = mask;
   }
   return masks;
 }

@@ -18,14 +18,14 @@ namespace rcfd {
 /// add 2 boundaryTolerance() to stay clear of the band in which firstIntersection() reports hits.
 std::vector<float> cellWallClearance(const Apparatus& apparatus, const CartesianGrid& grid, double margin);
 
-/// Per cell, a bit mask of the half-spaces (n . p >= c, e.g. Apparatus::convexHalfSpaces(), at most 8)
+/// Per cell, a bit mask of the half-spaces (n . p >= c, e.g. Apparatus::convexHalfSpaces(), at most 32)
 /// that a short move from the cell may come within `margin` of: bit j is clear only if every point p
 /// of the cell moved by any d with |d| <= reach ends at n_j . (p + d) - c_j >= margin. Points are taken
 /// within half a cell diagonal of the centre (signed distances to a plane are 1-Lipschitz), with a slack
 /// of 1e-6 of the smallest spacing over the rounding of the plane distances, so a test of a clear bit
-/// evaluated in double would pass too: skipping it changes no decision. One byte per cell, so the table
-/// (74 kB on the paper's grid) stays in cache beside the step fields.
-std::vector<std::uint8_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfSpace>& halfSpaces,
+/// evaluated in double would pass too: skipping it changes no decision. 32 bits per cell: the motion
+/// kernel gathers them a vector at a time (bytes have no vector gather).
+std::vector<std::uint32_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfSpace>& halfSpaces,
                                               const CartesianGrid& grid, double margin, double reach);
 
 }  // namespace rcfd

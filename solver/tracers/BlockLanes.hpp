@@ -119,7 +119,7 @@ struct Context {
   double margin = 0.0;              ///< 2 boundaryTolerance() [m]
   /// Per cell, the half-spaces a move of at most sqrt(nearReach2) from it may come within `margin` of
   /// (nearHalfSpaceMasks()); null: test them all
-  const std::uint8_t* nearHalfSpaces = nullptr;
+  const std::uint32_t* nearHalfSpaces = nullptr;
   double nearReach2 = 0.0;          ///< [m2]
   double noWall = 0.0;              ///< 1e300 without walls: every move is within reach
   double halfDiagonal = 0.0;        ///< half a cell diagonal: no point of a cell is farther from its centre [m]

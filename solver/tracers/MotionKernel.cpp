@@ -50,7 +50,7 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
     // test the outline's six planes, a cell at a V wall not the z walls. Moves of up to 1.5 cells (the
     // Courant limit's sub-steps, with room for the midpoint velocity) read their cell's mask; longer
     // ones test every plane.
-    if (halfSpaces_.size() <= 8) {  // the prism's and the box's outlines: 8 and 6
+    if (halfSpaces_.size() <= std::size_t(block::Context::kMaxHalfSpaces)) {
       nearReach_ = 1.5 * grid_.spacing.minCoeff();
       nearHalfSpaces_ = nearHalfSpaceMasks(halfSpaces_, grid_, 2.0 * apparatus_.boundaryTolerance(), nearReach_);
     }

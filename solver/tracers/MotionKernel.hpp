@@ -90,7 +90,7 @@ class MotionKernel {
   std::vector<float> plateReach_; ///< draft-plate distance of each cell centre less the band [m] (plates only)
   std::vector<Apparatus::HalfSpace> halfSpaces_;  ///< the open region's convex part
   /// Per cell, the half-spaces a move of at most nearReach_ may come near (nearHalfSpaceMasks())
-  std::vector<std::uint8_t> nearHalfSpaces_;
+  std::vector<std::uint32_t> nearHalfSpaces_;
   double nearReach_ = 0.0;        ///< [m]
   double minSpacing_;
   double inverseStokesTime_;      ///< 18 rho_G nu_G / (rho_P d_P^2) [1/s]

@@ -121,12 +121,13 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
     // a plane left out would have passed (nearHalfSpaceMasks()), so the decisions are those of testing all.
     const std::uint32_t all = (std::uint32_t(1) << bc.halfSpaces) - 1;
     std::uint32_t planes = all;
-    if (const std::uint8_t* near = bc.nearHalfSpaces) {
+    if (const std::uint32_t* near = bc.nearHalfSpaces) {
       const double nearReach2 = bc.nearReach2;
       planes = 0;
 #pragma omp simd reduction(| : planes)
-      for (int k = 0; k < m; ++k) {
-        const std::uint32_t lane = length2[k] <= nearReach2 ? std::uint32_t(near[cell[k]]) : all;
+      for (int k = 0; k < m; ++k) {  // loads unconditional, selects after: a gather and blends
+        const std::uint32_t cellPlanes = near[cell[k]];
+        const std::uint32_t lane = length2[k] <= nearReach2 ? cellPlanes : all;
         planes |= fast[k] != 0 ? 0u : lane;
       }
     }

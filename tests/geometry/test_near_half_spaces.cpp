@@ -67,7 +67,7 @@ TEST(NearHalfSpaces, MostCellsNeedFewOfThePlanes) {
   ASSERT_EQ(planes.size(), 8u);  // the outline's six edges and the two z walls
   const auto masks = nearHalfSpaceMasks(planes, grid, 2.0 * app.boundaryTolerance(), 0.0075);
   std::int64_t none = 0, planesKept = 0;
-  for (const std::uint8_t m : masks) {
+  for (const std::uint32_t m : masks) {
     none += m == 0;
     planesKept += std::popcount(m);
   }
@@ -78,7 +78,7 @@ TEST(NearHalfSpaces, MostCellsNeedFewOfThePlanes) {
   // Every cell touching a wall keeps that wall: the corner cell at the bottom of the V keeps the inlet,
   // a V wall and the front z wall.
   EXPECT_NE(masks[0], 0u);
-  EXPECT_THROW(nearHalfSpaceMasks(std::vector<Apparatus::HalfSpace>(9), grid, 0.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(nearHalfSpaceMasks(std::vector<Apparatus::HalfSpace>(33), grid, 0.0, 0.0), std::invalid_argument);
 }
 
 }  // namespace
