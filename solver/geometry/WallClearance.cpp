@@ -5,9 +5,11 @@
 #include <stdexcept>
 
 namespace rcfd {
+namespace {
+constexpr std::int64_t kParallelCells = 4096;  // below this a team costs more than it saves
+}  // namespace
 
 std::vector<float> cellWallClearance(const Apparatus& apparatus, const CartesianGrid& grid, double margin) {
-  constexpr std::int64_t kParallelCells = 4096;  // below this a team costs more than it saves
   std::vector<float> clearance(std::size_t(grid.cellCount()));
 #pragma omp parallel for schedule(static) if (grid.cellCount() > kParallelCells)
   for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
@@ -25,7 +27,7 @@ std::vector<std::uint32_t> nearHalfSpaceMasks(const std::vector<Apparatus::HalfS
   const double slack = 1e-6 * grid.spacing.minCoeff();
   const double within = margin + halfDiagonal + reach + slack;
   std::vector<std::uint32_t> masks(std::size_t(grid.cellCount()));
-#pragma omp parallel for schedule(static) if (grid.cellCount() > 4096)
+#pragma omp parallel for schedule(static) if (grid.cellCount() > kParallelCells)
   for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
     const auto ijk = grid.cellIjk(c);
     const Eigen::Vector3d centre = grid.cellCenter(ijk[0], ijk[1], ijk[2]);

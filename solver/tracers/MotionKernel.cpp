@@ -52,7 +52,7 @@ MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& setti
     // ones test every plane.
     if (halfSpaces_.size() <= std::size_t(block::Context::kMaxHalfSpaces)) {
       nearReach_ = 1.5 * grid_.spacing.minCoeff();
-      nearHalfSpaces_ = nearHalfSpaceMasks(halfSpaces_, grid_, 2.0 * apparatus_.boundaryTolerance(), nearReach_);
+      nearHalfSpaces_ = nearHalfSpaceMasks(halfSpaces_, grid_, band, nearReach_);
     }
     // Distance from each cell centre to the draft plates less the band: a move with
     // |p - centre| + |disp| below it cannot reach a plate (the block path's second wall test).
