@@ -27,6 +27,7 @@ namespace {
 
 constexpr double kMinDropletsPerParcel = 1.0;  ///< N_D,min of the paper
 constexpr std::int64_t kPicksPerBinomial = 32;  ///< see DepositionEffect::distribute
+constexpr std::int64_t kScanBlock = 256;        ///< tracers tested together in DepositionEffect::handOut
 
 class DepositionEffect final : public TracerEffect {
  public:
@@ -42,12 +43,13 @@ class DepositionEffect final : public TracerEffect {
     state_->tracerDroplets.assign(ctx.cloud.size(), 0.0);
     due_.assign(std::size_t(ctx.grid.cellCount()), 0);
     slot_.assign(std::size_t(ctx.grid.cellCount()), -1);
+    dueBits_.assign((std::size_t(ctx.grid.cellCount()) + 31) / 32, 0);
   }
 
   std::size_t allocatedBytes() const override {
     return (state_->cellDeposit.capacity() + state_->cellPending.capacity() + state_->tracerDroplets.capacity()) *
                sizeof(double) +
-           (due_.capacity() + slot_.capacity()) * sizeof(std::int32_t);
+           (due_.capacity() + slot_.capacity() + dueBits_.capacity()) * sizeof(std::int32_t);
   }
 
   bool afterMoveBesideMotion() const override { return true; }
@@ -154,6 +156,7 @@ class DepositionEffect final : public TracerEffect {
       if (due_[std::size_t(c)] > 0) {
         slot_[std::size_t(c)] = std::int32_t(slotCells_.size());
         slotCells_.push_back(c);
+        dueBits_[std::size_t(c) >> 5] |= std::uint32_t(1) << (c & 31);
       }
     }
     const std::size_t slots = slotCells_.size();
@@ -162,6 +165,7 @@ class DepositionEffect final : public TracerEffect {
     const int threads = parallel ? omp_get_max_threads() : 1;
     const std::int32_t* cellOf = ctx.tracerCell.data();
     const std::int32_t* slotOf = slot_.data();
+    const std::uint32_t* dueBits = dueBits_.data();
     found_.resize(std::size_t(threads));
     int team = 1;  // a team may be smaller than asked for (nested inside a calibration's threads)
 #pragma omp parallel num_threads(threads) if (parallel)
@@ -172,10 +176,22 @@ class DepositionEffect final : public TracerEffect {
       const std::int64_t first = n * t / used, last = n * (t + 1) / used;
       auto& mine = found_[std::size_t(t)];
       mine.clear();
-      for (std::int64_t i = first; i < last; ++i) {
-        if (slotOf[cellOf[i]] >= 0) mine.push_back(std::int32_t(i));
+      // Blocks of tracers tested against the bitmap of the cells with droplets due (9 KB for 74k cells,
+      // in L1, where the slot array is not), in a loop that vectorises (a gather per 16 tracers); the
+      // few blocks with a member are then walked tracer by tracer, in order.
+      for (std::int64_t i0 = first; i0 < last; i0 += kScanBlock) {
+        const int count = int(std::min(kScanBlock, last - i0));
+        const std::int32_t* cells = cellOf + i0;
+        std::uint32_t any = 0;
+#pragma omp simd reduction(| : any)
+        for (int k = 0; k < count; ++k) any |= dueBits[cells[k] >> 5] >> (cells[k] & 31);
+        if ((any & 1u) == 0) continue;
+        for (int k = 0; k < count; ++k) {
+          if ((dueBits[cells[k] >> 5] >> (cells[k] & 31)) & 1u) mine.push_back(std::int32_t(i0 + k));
+        }
       }
     }
+    for (const std::int32_t c : slotCells_) dueBits_[std::size_t(c) >> 5] = 0;
     found_.resize(std::size_t(team));
     slotStart_.assign(slots + 1, 0);
     for (const auto& range : found_) {
@@ -249,6 +265,7 @@ class DepositionEffect final : public TracerEffect {
   std::vector<std::int32_t> waiting_;   ///< cells keeping a fraction of a droplet
   std::vector<std::int32_t> members_;     ///< tracers of the cells with droplets due, grouped by cell
   std::vector<std::int32_t> slot_;        ///< per cell: its slot this step, or -1
+  std::vector<std::uint32_t> dueBits_;    ///< one bit per cell: set for the cells with droplets due
   std::vector<std::int32_t> slotCells_;   ///< cells with droplets due, in cell order
   std::vector<std::int64_t> slotStart_;   ///< members_ of slot k: [slotStart_[k], slotStart_[k + 1])
   std::vector<std::int64_t> cursor_;      ///< per slot: the next write position in members_
