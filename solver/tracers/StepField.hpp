@@ -11,6 +11,10 @@
 #include <utility>
 #include <vector>
 
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
+
 #include <Eigen/Core>
 
 #include "tracers/BlockSampling.hpp"
@@ -28,17 +32,29 @@ class StepVelocityField {
     const double w = sampler.blend();
     const std::int64_t cells = std::int64_t(fa.size() / 3);
     data_.resize(std::size_t(cells));
+    const float* const a = fa.data();
+    float* const out = data_.empty() ? nullptr : data_[0].data();
+    if (fb) {
+#pragma omp parallel for schedule(static) if (parallel)
+      for (std::int64_t c = 0; c < cells; ++c) {
+        for (int d = 0; d < 3; ++d) {
+          out[4 * c + d] = float(double(a[3 * c + d]) + w * (double(fb[3 * c + d]) - double(a[3 * c + d])));
+        }
+        out[4 * c + 3] = 0.0f;
+      }
+      return;
+    }
+    // A step on a frame itself (every step when the database is sampled at the step): a copy, one
+    // masked 16-byte load and one store per cell with AVX-512; GCC's own loop moved a float at a time,
+    // a quarter of a millisecond per field of 74k cells on the thread beside the motion.
 #pragma omp parallel for schedule(static) if (parallel)
     for (std::int64_t c = 0; c < cells; ++c) {
-      const float* a = fa.data() + 3 * c;
-      Eigen::Array4f& out = data_[std::size_t(c)];
-      if (fb) {
-        const float* b = fb + 3 * c;
-        for (int d = 0; d < 3; ++d) out[d] = float(double(a[d]) + w * (double(b[d]) - double(a[d])));
-      } else {
-        out[0] = a[0], out[1] = a[1], out[2] = a[2];
-      }
-      out[3] = 0.0f;
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+      _mm_store_ps(out + 4 * c, _mm_maskz_loadu_ps(0x7, a + 3 * c));  // (x, y, z, 0), no read past z
+#else
+      for (int d = 0; d < 3; ++d) out[4 * c + d] = a[3 * c + d];
+      out[4 * c + 3] = 0.0f;
+#endif
     }
   }
 
