@@ -69,3 +69,26 @@ TEST(StepFields, AFieldBuiltAheadForOtherFramesIsNotTaken) {
 }
 
 }  // namespace
+
+TEST(StepFields, AFieldHoldsItsFramesValuesPaddedWithZero) {
+  // On a frame (a copy, the vector path) and between two (the blend in double): (x, y, z, 0) per cell.
+  const ThreeFrames t;
+  const auto f1 = t.db->frame(1), f2 = t.db->frame(2);
+  for (const bool useGas : {false, true}) {
+    const auto& a = useGas ? f1->u_g : f1->u_p;
+    const auto& b = useGas ? f2->u_g : f2->u_p;
+    const StepVelocityField onFrame = t.built(1, 1, 0.0, useGas);
+    const StepVelocityField between = t.built(1, 2, 0.25, useGas);
+    std::size_t wrong = 0;
+    for (std::int64_t c = 0; c < t.grid.cellCount(); ++c) {
+      for (int d = 0; d < 4; ++d) {
+        const std::size_t i = 3 * std::size_t(c) + std::size_t(d);
+        const float copied = d < 3 ? a[i] : 0.0f;
+        const float blended = d < 3 ? float(double(a[i]) + 0.25 * (double(b[i]) - double(a[i]))) : 0.0f;
+        wrong += onFrame.floats()[4 * c + d] != copied;
+        wrong += between.floats()[4 * c + d] != blended;
+      }
+    }
+    EXPECT_EQ(wrong, 0u) << "useGas " << useGas;
+  }
+}
