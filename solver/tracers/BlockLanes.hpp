@@ -54,26 +54,29 @@ struct LaneStorage {
   }
 };
 
-/// The lanes of `lanes` with sub-steps left, in lane order, into `out`; returns their number. A bit
-/// mask of them first (eight lanes per compare with AVX2), then its set bits: few lanes of a block have
-/// sub-steps left, and a lane-by-lane pass over all 64 took 40% of defer().
-inline int lanesWithSubstepsLeft(const Lanes& lanes, std::int32_t* out) {
+/// The lanes k < n with v[k] > 0, in lane order, into `out`; returns their number. A bit mask of them
+/// first (eight lanes per compare with AVX2), then its set bits: where few lanes qualify, a lane-by-lane
+/// pass over all 64 took 40% of defer(), and a branch per lane mispredicts.
+inline int positiveLanes(const std::int32_t* v, int n, std::int32_t* out) {
   static_assert(kBlock <= 64, "one bit per lane in a 64-bit mask");
-  const int n = lanes.count;
-  const std::int32_t* const left = lanes.left;
   std::uint64_t mask = 0;
   int k = 0;
 #if defined(__AVX2__)
   for (; k + 8 <= n; k += 8) {
-    const __m256i more = _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(left + k)),
+    const __m256i more = _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(v + k)),
                                             _mm256_setzero_si256());
     mask |= std::uint64_t(std::uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(more)))) << k;
   }
 #endif
-  for (; k < n; ++k) mask |= std::uint64_t(left[k] > 0) << k;
+  for (; k < n; ++k) mask |= std::uint64_t(v[k] > 0) << k;
   int r = 0;
   for (; mask != 0; mask &= mask - 1) out[r++] = std::countr_zero(mask);
   return r;
+}
+
+/// The lanes of `lanes` with sub-steps left, in lane order, into `out`; returns their number.
+inline int lanesWithSubstepsLeft(const Lanes& lanes, std::int32_t* out) {
+  return positiveLanes(lanes.left, lanes.count, out);
 }
 
 /// The number of lanes with sub-steps left.
@@ -167,21 +170,33 @@ constexpr double kOneSubstepMargin = 1.0 - 1e-9;
   // table. Its margin keeps it inside the exact test below; NaN fails it and takes the exact path.
   const double scale = dt * inverseLimit;
   const double oneLimitSquared = kOneSubstepMargin / (scale * scale);
+  alignas(64) std::int32_t beyondLane[kBlock];
   std::int32_t beyond = 0;
 #pragma omp simd reduction(+ : beyond)
   for (int k = 0; k < count; ++k) {
     const double speed2 = ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k];
-    beyond += std::int32_t(!(speed2 <= oneLimitSquared));
+    beyondLane[k] = std::int32_t(!(speed2 <= oneLimitSquared));
+    beyond += beyondLane[k];
   }
   if (beyond == 0) {
 #pragma omp simd
     for (int k = 0; k < count; ++k) h[k] = dt, left[k] = 0;  // dt / 1, as lengths[1]
     return 0;
   }
-  alignas(64) std::int32_t over[kBlock];
+  // The exact count only for the lanes beyond one limit (10 of 64 on average where there are any),
+  // gathered into full vectors: over all 64 lanes the square roots and the table cost twice the rest of
+  // this function. The others take one sub-step of dt.
 #pragma omp simd
-  for (int k = 0; k < count; ++k) {
-    const double distance = std::sqrt(ux[k] * ux[k] + uy[k] * uy[k] + uz[k] * uz[k]) * dt;
+  for (int k = 0; k < count; ++k) h[k] = dt, left[k] = 0;
+  alignas(64) double bx[kBlock], by[kBlock], bz[kBlock];
+  alignas(64) double hb[kBlock];
+  alignas(64) std::int32_t leftb[kBlock], over[kBlock];
+  std::int32_t lane[kBlock];
+  const int r = positiveLanes(beyondLane, count, lane);
+  for (int j = 0; j < r; ++j) bx[j] = ux[lane[j]], by[j] = uy[lane[j]], bz[j] = uz[lane[j]];
+#pragma omp simd
+  for (int j = 0; j < r; ++j) {
+    const double distance = std::sqrt(bx[j] * bx[j] + by[j] * by[j] + bz[j] * bz[j]) * dt;
     const double courant = distance * inverseLimit;
     const bool within = courant <= kMax;  // false also for NaN
     const double c = within ? courant : kMax;  // in [0, kMax]
@@ -192,20 +207,20 @@ constexpr double kOneSubstepMargin = 1.0 - 1e-9;
     const std::int32_t up = whole + std::int32_t(double(whole) < c);
     const std::int32_t nsub = up > 1 ? up : 1;
 #if defined(__AVX512F__)
-    h[k] = lengths[nsub];
+    hb[j] = lengths[nsub];
 #else
-    h[k] = dt / double(nsub);  // = lengths[nsub]
+    hb[j] = dt / double(nsub);  // = lengths[nsub]
 #endif
-    left[k] = nsub - 1;
-    over[k] = within ? 0 : 1;
+    leftb[j] = nsub - 1;
+    over[j] = within ? 0 : 1;
   }
   // Summed in int32 (at most kBlock * kMax): int64 sums of int32 lanes cost a conversion per lane.
   std::int32_t added = 0, cappedHere = 0;
   std::int32_t maxLeft = 0;
-#pragma omp simd reduction(+ : added, cappedHere) reduction(max : maxLeft)
-  for (int k = 0; k < count; ++k) {
-    added += left[k], cappedHere += over[k];
-    maxLeft = left[k] > maxLeft ? left[k] : maxLeft;
+  for (int j = 0; j < r; ++j) {
+    h[lane[j]] = hb[j], left[lane[j]] = leftb[j];
+    added += leftb[j], cappedHere += over[j];
+    maxLeft = leftb[j] > maxLeft ? leftb[j] : maxLeft;
   }
   extra += added, capped += cappedHere;
   return maxLeft;
