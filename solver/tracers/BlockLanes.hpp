@@ -44,11 +44,13 @@ struct LaneStorage {
   Lanes view(int count, bool withCells = false) {
     return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count, withCells ? cell : nullptr, withCells ? reach : nullptr};
   }
-  /// Copies lane k of `from` (position, u_fluc, velocity, sub-step, sub-steps left) into lane j.
-  void copyLane(const Lanes& from, int k, int j) {
+  /// Copies lane k of `from` (position, u_fluc, sub-step, sub-steps left, and the velocity if
+  /// `velocity`) into lane j. A round along u_P^rec samples its velocity before reading it, so only
+  /// free flight needs the velocity copied in.
+  void copyLane(const Lanes& from, int k, int j, bool velocity) {
     x[j] = from.x[k], y[j] = from.y[k], z[j] = from.z[k];
     ax[j] = from.ax[k], ay[j] = from.ay[k], az[j] = from.az[k];
-    ux[j] = from.ux[k], uy[j] = from.uy[k], uz[j] = from.uz[k];
+    if (velocity) ux[j] = from.ux[k], uy[j] = from.uy[k], uz[j] = from.uz[k];
     h[j] = from.h[k];
     left[j] = from.left[k];
   }

@@ -229,15 +229,16 @@ void MotionKernel::advanceLanes(block::Lanes& L, std::int32_t maxLeft, block::Bl
       continue;
     }
     for (int j = 0; j < r; ++j) {
-      rs.copyLane(L, rs.lane[j], j);
+      rs.copyLane(L, rs.lane[j], j, freeFlying);
       --L.left[rs.lane[j]];
     }
     Lanes R = rs.view(r);
     subStepRound(R);
+    const bool velocity = freeFlying || bc.keepVelocity;  // else no one reads it
     for (int j = 0; j < r; ++j) {
       const int k = rs.lane[j];
       L.x[k] = R.x[j], L.y[k] = R.y[j], L.z[k] = R.z[j];
-      L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
+      if (velocity) L.ux[k] = R.ux[j], L.uy[k] = R.uy[j], L.uz[k] = R.uz[j];
     }
   }
 }
@@ -279,7 +280,7 @@ void MotionKernel::defer(const block::Lanes& L, std::int64_t i0, const std::int3
     const int k = lanes[q];
     if (d.count == kBlock) finishDeferred(d, freeFlying, s, bc, st);
     const int j = d.count++;
-    d.s.copyLane(L, k, j);
+    d.s.copyLane(L, k, j, freeFlying);
     d.tracer[j] = i0 + (laneOf ? laneOf[k] : k);
   }
 }
