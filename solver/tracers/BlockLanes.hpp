@@ -13,6 +13,7 @@
 #endif
 
 #include "tracers/BlockSampling.hpp"
+#include "tracers/CellIndex.hpp"
 
 namespace rcfd::block {
 
@@ -96,10 +97,11 @@ inline int countLanesWithSubstepsLeft(const Lanes& lanes) {
 /// round in place about as much as 64 lanes' rounds; in the benchmark's spout every lane has one.
 constexpr int kInPlaceLanes = 32;
 
-/// Lanes, from the blocks of one chunk, with sub-steps left after their first: moved together when the
-/// storage is full or the chunk ends, so later sub-steps run on full vectors rather than on the one or
-/// two lanes a block has (each round has a fixed cost: in the benchmark 2.2% of the tracers took 19%
-/// of the kernel's time in per-block rounds).
+/// Lanes, from the blocks a thread moves, with sub-steps left after their first: moved together when
+/// the storage is full or the thread has no chunk left, so later sub-steps run on full vectors rather
+/// than on the one or two lanes a block has (each round has a fixed cost: in the benchmark 2.2% of the
+/// tracers took 19% of the kernel's time in per-block rounds). Which lanes share a round depends on the
+/// schedule; a lane's arithmetic does not.
 struct DeferredLanes {
   LaneStorage s;
   std::int64_t tracer[kBlock];  ///< the lane's tracer
@@ -139,6 +141,9 @@ struct Context {
   double *cloudX = nullptr, *cloudY = nullptr, *cloudZ = nullptr;
   double *cloudVx = nullptr, *cloudVy = nullptr, *cloudVz = nullptr;
   bool keepVelocity = false;
+  /// The tracers' cells after the move (TracerContext::nextTracerCell), or null; with `cellIndexer`.
+  std::int32_t* nextCells = nullptr;
+  const CellIndexer* cellIndexer = nullptr;
 };
 
 /// Eq. (9): u = u_P^rec + u_fluc at the lanes' positions, located in float grid coordinates: into the

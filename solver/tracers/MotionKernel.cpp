@@ -284,6 +284,7 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   // `beside` on the team's last thread, which then takes what chunks are left (an exception is carried
   // out of the parallel region, which it must not leave).
   std::exception_ptr besideFailure;
+  bc.nextCells = nextCells, bc.cellIndexer = &indexer;
 #pragma omp parallel if (n > kParallelThreshold) \
     reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests, blocksInPlace)
   {
@@ -294,11 +295,17 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
       besideFailure = std::current_exception();
     }
   }
+  // Defined in the region, so that it adds to the thread's copies of the reduction's counters.
+  auto addStatistics = [&](const MotionStatistics& st) {
+    substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
+    scalarPath += st.scalarPath, exactWallTests += st.exactWallTests, blocksInPlace += st.blocksInPlace;
+  };
+  // The thread's deferred lanes, carried from chunk to chunk so that their rounds run full.
+  DeferredLanes deferred, deferredFree;
+  BlockStencils stencils;
 #pragma omp for schedule(dynamic, 1) nowait
   for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {
     MotionStatistics st;
-    DeferredLanes deferred, deferredFree;
-    BlockStencils stencils;
     for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
       const std::int64_t i0 = b * kBlock;
       const int count = int(std::min<std::int64_t>(kBlock, n - i0));
@@ -410,15 +417,17 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
         }
       }
     }
-    finishDeferred(deferred, false, stencils, bc, st);
-    finishDeferred(deferredFree, true, stencils, bc, st);
     if (nextCells) {  // the chunk's new positions are still in cache: their cells, for the next step
+      // (deferred lanes are between sub-steps: finishDeferred() writes their cells when it moves them)
       const std::int64_t first = chunk * kChunk * kBlock, last = std::min(n, (chunk + 1) * kChunk * kBlock);
       indexer.cellsOf(int(last - first), px + first, py + first, pz + first, nextCells + first);
     }
-    substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
-    scalarPath += st.scalarPath, exactWallTests += st.exactWallTests, blocksInPlace += st.blocksInPlace;
+    addStatistics(st);
   }
+  MotionStatistics st;
+  finishDeferred(deferred, false, stencils, bc, st);
+  finishDeferred(deferredFree, true, stencils, bc, st);
+  addStatistics(st);
   }
   if (besideFailure) std::rethrow_exception(besideFailure);
   if (nextCells) ctx.nextTracerCellStep = ctx.step + 1;

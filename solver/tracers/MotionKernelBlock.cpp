@@ -297,6 +297,11 @@ void MotionKernel::finishDeferred(block::DeferredLanes& d, bool freeFlying, bloc
     bc.cloudX[i] = D.x[j], bc.cloudY[i] = D.y[j], bc.cloudZ[i] = D.z[j];
     if (bc.keepVelocity) bc.cloudVx[i] = D.ux[j], bc.cloudVy[i] = D.uy[j], bc.cloudVz[i] = D.uz[j];
   }
+  if (bc.nextCells) {  // over the cells its chunk's end found for the positions after the first sub-step
+    alignas(64) std::int32_t cells[kBlock];
+    bc.cellIndexer->cellsOf(d.count, D.x, D.y, D.z, cells);
+    for (int j = 0; j < d.count; ++j) bc.nextCells[d.tracer[j]] = cells[j];
+  }
   d.count = 0;
 }
 
