@@ -273,8 +273,9 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   const bool vectorised = settings_.vectorised;
   // Dynamic chunks of blocks: sub-stepped and near-wall tracers cluster (in the spout, at the walls), so
   // equal shares of blocks are not equal work. Lanes with sub-steps left after their first are
-  // deferred to the end of their chunk (or until 64 have gathered) and move together. Blocks and chunks
-  // are fixed and counters are integers, so results do not depend on which thread moves which chunk.
+  // deferred until 64 have gathered on the thread (or it has no chunk left) and move together. Blocks and
+  // chunks are fixed, a lane's arithmetic does not depend on which lanes share its rounds, and counters
+  // are integers, so results do not depend on which thread moves which chunk.
   bc.cloudX = px, bc.cloudY = py, bc.cloudZ = pz, bc.cloudVx = pvx, bc.cloudVy = pvy, bc.cloudVz = pvz;
   bc.keepVelocity = settings_.freeFlight;
   constexpr std::int64_t kChunk = 16;  // blocks
