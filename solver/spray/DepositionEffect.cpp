@@ -184,10 +184,10 @@ class DepositionEffect final : public TracerEffect {
         const std::int32_t* cells = cellOf + i0;
         std::uint32_t any = 0;
 #pragma omp simd reduction(| : any)
-        for (int k = 0; k < count; ++k) any |= dueBits[cells[k] >> 5] >> (cells[k] & 31);
-        if ((any & 1u) == 0) continue;
+        for (int k = 0; k < count; ++k) any |= dueBit(dueBits, cells[k]);
+        if (any == 0) continue;
         for (int k = 0; k < count; ++k) {
-          if ((dueBits[cells[k] >> 5] >> (cells[k] & 31)) & 1u) mine.push_back(std::int32_t(i0 + k));
+          if (dueBit(dueBits, cells[k])) mine.push_back(std::int32_t(i0 + k));
         }
       }
     }
@@ -218,6 +218,9 @@ class DepositionEffect final : public TracerEffect {
     }
     s.assigned += assigned;
   }
+
+  /// Bit `cell` of a bitmap as 0 or 1 (a signed index: GCC gathers with it, not with an unsigned one).
+  static std::uint32_t dueBit(const std::uint32_t* bits, std::int32_t cell) { return (bits[cell >> 5] >> (cell & 31)) & 1u; }
 
   /// Hands `droplets` whole droplets to the tracers members_[start, end) with equal probability each: a
   /// multinomial draw. Up to kPicksPerBinomial droplets per tracer: one uniform pick per droplet; more:

@@ -185,16 +185,12 @@ constexpr double kOneSubstepMargin = 1.0 - 1e-9;
     beyondLane[k] = std::int32_t(!(speed2 <= oneLimitSquared));
     beyond += beyondLane[k];
   }
-  if (beyond == 0) {
 #pragma omp simd
-    for (int k = 0; k < count; ++k) h[k] = dt, left[k] = 0;  // dt / 1, as lengths[1]
-    return 0;
-  }
+  for (int k = 0; k < count; ++k) h[k] = dt, left[k] = 0;  // dt / 1, as lengths[1]
+  if (beyond == 0) return 0;
   // The exact count only for the lanes beyond one limit (10 of 64 on average where there are any),
   // gathered into full vectors: over all 64 lanes the square roots and the table cost twice the rest of
-  // this function. The others take one sub-step of dt.
-#pragma omp simd
-  for (int k = 0; k < count; ++k) h[k] = dt, left[k] = 0;
+  // this function.
   alignas(64) double bx[kBlock], by[kBlock], bz[kBlock];
   alignas(64) double hb[kBlock];
   alignas(64) std::int32_t leftb[kBlock], over[kBlock];
@@ -221,7 +217,7 @@ constexpr double kOneSubstepMargin = 1.0 - 1e-9;
     leftb[j] = nsub - 1;
     over[j] = within ? 0 : 1;
   }
-  // Summed in int32 (at most kBlock * kMax): int64 sums of int32 lanes cost a conversion per lane.
+  // Back to their lanes, and summed in int32 (at most kBlock * kMax).
   std::int32_t added = 0, cappedHere = 0;
   std::int32_t maxLeft = 0;
   for (int j = 0; j < r; ++j) {
