@@ -192,10 +192,10 @@ void floorStepFloat(const FloorCase& c, FloorParts parts, const CounterRngPrefix
 /// without it, returns false and moves nothing).
 bool floorStepGradient(const FloorCase& c) {
 #if defined(__AVX2__) && defined(__FMA__)
-  if (!c.corners.adjacentX) return false;
+  if (!c.corners.pairLoads) return false;
   const std::int64_t blocks = (c.n + kBlock - 1) / kBlock;
   constexpr std::int64_t kChunk = 16;
-  const std::int32_t o0 = c.corners.off4[0], o2 = c.corners.off4[2], o4 = c.corners.off4[4], o6 = c.corners.off4[6];
+  const std::int32_t o0 = c.corners.off[0], o2 = c.corners.off[2], o4 = c.corners.off[4], o6 = c.corners.off[6];
   // Gradients per grid coordinate times the inverse spacing: per metre.
   const __m128 inverseSpacing = _mm_setr_ps(float(c.q.ix), float(c.q.iy), float(c.q.iz), 0.0f);
   const __m128 halfStep = _mm_set1_ps(float(0.5 * c.dt));

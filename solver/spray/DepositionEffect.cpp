@@ -83,7 +83,7 @@ class DepositionEffect final : public TracerEffect {
     // |u_G - u_P| from the step fields the spray parcels and the motion kernel read (float trilinear):
     // 2 x 8 corners in double per parcel cost as much as moving the parcels.
     const FrameSampler sampler = ctx.sampler();
-    const StepFieldSampler gas(ctx.stepVelocity(true), sampler.locator());
+    const StepFieldSampler gas(ctx.stepVelocity(true, StepFieldLayout::Any), sampler.locator());
     const StepFieldSampler particles(ctx.stepVelocity(false), sampler.locator());
 #pragma omp parallel for schedule(static) if (n > kParallelThreshold)
     for (std::int64_t j = 0; j < n; ++j) {

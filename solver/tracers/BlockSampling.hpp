@@ -1,13 +1,15 @@
 #pragma once
 /// \file BlockSampling.hpp
-/// Trilinear sampling of a step field (4 floats per cell) at the points of a block of tracers: locate
-/// every point in a loop the compiler vectorises, then combine each lane's 8 corners. With AVX2 and FMA
-/// a lane's corners come in as 4 contiguous 32-byte loads (the x-neighbours of a corner are adjacent
-/// in memory) and are combined two corners and 3 components at a time: 4 loads and 7 vector
-/// operations in place of 24 element gathers (AVX-512 gathers cost about one load per element), 1.4x
-/// on the whole tracer step. Both the block path and the scalar path combine corners with
-/// interpolateCorners() (float, fused multiply-adds, z then y then x), so they give bit-identical
-/// velocities. Internal to the motion kernel.
+/// Trilinear sampling of a step field (4 floats per cell, or a frame's own 3) at the points of a block
+/// of tracers: locate every point in a loop the compiler vectorises, then combine each lane's 8 corners.
+/// With AVX2 and FMA and 4 floats per cell, a lane's corners come in as 4 contiguous 32-byte loads (the
+/// x-neighbours of a corner are adjacent in memory) and are combined two corners and 3 components at a
+/// time: 4 loads and 7 vector operations in place of 24 element gathers (AVX-512 gathers cost about one
+/// load per element), 1.4x on the whole tracer step. (3 floats per cell, the frames' layout, would save
+/// the step field's copy, but its pair loads split cache lines more often and need a shuffle: the
+/// tracer step took 3-5% longer, measured with bench/ab-tracers.sh.) Both the block path and the scalar
+/// path combine corners with interpolateCorners() (float, fused multiply-adds, z then y then x), so they
+/// give bit-identical velocities. Internal to the motion kernel.
 
 #include <bit>
 #include <cmath>
@@ -37,15 +39,15 @@ struct BlockStencils {
   alignas(64) float ux[kBlock], uy[kBlock], uz[kBlock];
 };
 
-/// The combination of the 8 corners (corner c at c4 + off4[c], 4 floats each; bit 0 of c is x, bit 1
-/// y, bit 2 z) with fractions (fx, fy, fz): linear interpolation along z, then y, then x, each
+/// The combination of the 8 corners (corner c at field + off[c]; bit 0 of c is x, bit 1 y, bit 2 z) with fractions (fx, fy, fz): linear interpolation along z, then y, then x, each
 /// a + f (b - a) as one fused multiply-add in float. Exact for a uniform field. The scalar reference
 /// of sampleBlock().
-inline void interpolateCorners(const float* c4, const std::int32_t* off4, float fx, float fy, float fz, float out[3]) {
+inline void interpolateCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
+                               float out[3]) {
   for (int d = 0; d < 3; ++d) {
     float t[4];
     for (int j = 0; j < 4; ++j) {
-      const float a = c4[off4[j] + d], b = c4[off4[j + 4] + d];
+      const float a = field[off[j] + d], b = field[off[j + 4] + d];
       t[j] = std::fma(fz, b - a, a);
     }
     const float s0 = std::fma(fy, t[2] - t[0], t[0]);
@@ -136,15 +138,18 @@ inline void locateGridBlock(const GridConstants& q, int count, const float* gx, 
   }
 }
 
-/// The step field's corner offsets (in floats) and whether each corner's x-neighbour is the next cell
-/// (every grid with more than one layer in x), which the AVX2 path needs for its 32-byte loads.
+/// The step field's corner offsets (in floats) and whether the AVX2 path's 32-byte corner-pair loads
+/// apply: 4 floats per cell, and each corner's x-neighbour the next cell (every grid with more than one
+/// layer in x).
 struct CornerOffsets {
-  std::int32_t off4[8] = {};
-  bool adjacentX = false;
-  void set(const std::int32_t* cellOffsets) {
-    adjacentX = true;
-    for (int c = 0; c < 8; ++c) off4[c] = 4 * cellOffsets[c];
-    for (int c = 0; c < 8; c += 2) adjacentX = adjacentX && off4[c + 1] == off4[c] + 4;
+  std::int32_t off[8] = {};
+  int stride = 4;  ///< floats per cell: 4 (x, y, z, 0), or 3 (x, y, z) on a frame's own array
+  bool pairLoads = false;
+  void set(const std::int32_t* cellOffsets, int floatsPerCell = 4) {
+    stride = floatsPerCell;
+    pairLoads = stride == 4;
+    for (int c = 0; c < 8; ++c) off[c] = stride * cellOffsets[c];
+    for (int c = 0; c < 8; c += 2) pairLoads = pairLoads && off[c + 1] == off[c] + stride;
   }
 };
 
@@ -154,8 +159,8 @@ struct CornerOffsets {
 inline void sampleBlock3(const float* field, const CornerOffsets& co, const BlockStencils& s, int count, float* ux,
                          float* uy, float* uz) {
 #ifdef RCFD_BLOCK_SAMPLING_AVX2
-  if (co.adjacentX) {
-    const std::int32_t o0 = co.off4[0], o2 = co.off4[2], o4 = co.off4[4], o6 = co.off4[6];
+  if (co.pairLoads) {
+    const std::int32_t o0 = co.off[0], o2 = co.off[2], o4 = co.off[4], o6 = co.off[6];
     for (int k = 0; k < count; ++k) {
       const float* c = field + 4 * std::int64_t(s.base[k]);
       // Corners (c0 c1), (c2 c3), (c4 c5), (c6 c7), 8 floats each: a corner's x-neighbour is adjacent.
@@ -176,7 +181,7 @@ inline void sampleBlock3(const float* field, const CornerOffsets& co, const Bloc
 #endif
   for (int k = 0; k < count; ++k) {
     float u[3];
-    interpolateCorners(field + 4 * std::int64_t(s.base[k]), co.off4, s.fx[k], s.fy[k], s.fz[k], u);
+    interpolateCorners(field + co.stride * std::int64_t(s.base[k]), co.off, s.fx[k], s.fy[k], s.fz[k], u);
     ux[k] = u[0], uy[k] = u[1], uz[k] = u[2];
   }
 }

@@ -2,9 +2,11 @@
 /// \file StepField.hpp
 /// A recurrence velocity field prepared for one tracer step: 4 floats per cell (x, y, z, 0), 16-byte
 /// aligned, blended between the step's two frames once per cell rather than once per tracer and
-/// corner. The motion kernel then fetches a corner and its x-neighbour with one 32-byte load. Rebuilding costs one pass
-/// over the cells (74k) per step against 8-16 corner loads for each of the 473k tracers.
-/// Blended values are rounded to float, the precision the database stores frames in.
+/// corner. The motion kernel then fetches a corner and its x-neighbour with one 32-byte load.
+/// Rebuilding costs one pass over the cells (74k) per step against 8-16 corner loads for each of the
+/// 473k tracers. Stages that sample a few points (spray parcels, deposition) take, on a frame, the
+/// frame's own 3 floats per cell instead (StepFieldLayout::Any). Blended values are rounded to float,
+/// the precision the database stores frames in.
 
 #include <cstdint>
 #include <memory>
@@ -22,12 +24,24 @@
 
 namespace rcfd {
 
+/// How a stage reads a step field: with the block path's corner-pair loads (Padded: 4 floats per cell),
+/// or at a few points only (Any: on a frame, the frame's own array of 3 floats per cell does, and
+/// costs no copy).
+enum class StepFieldLayout { Padded, Any };
+
 class StepVelocityField {
  public:
-  /// Fills the field from the sampler's frame(s): u_P^rec, or u_G^rec when useGas.
-  void build(const FrameSampler& sampler, bool useGas, bool parallel) {
+  /// Fills the field from the sampler's frame(s): u_P^rec, or u_G^rec when useGas. With layout Any, a
+  /// step on a frame refers to the frame's array, which must outlive the field's use (the step's frames
+  /// are held for the step: TracerContext, StepFields).
+  void build(const FrameSampler& sampler, bool useGas, bool parallel, StepFieldLayout layout = StepFieldLayout::Padded) {
     const auto& fa = useGas ? sampler.frame().u_g : sampler.frame().u_p;
     const FieldFrame* next = sampler.nextFrame();
+    frameValues_ = nullptr;
+    if (!next && layout == StepFieldLayout::Any) {
+      frameValues_ = fa.data();
+      return;
+    }
     const float* fb = next ? (useGas ? next->u_g : next->u_p).data() : nullptr;
     const double w = sampler.blend();
     const std::int64_t cells = std::int64_t(fa.size() / 3);
@@ -58,10 +72,13 @@ class StepVelocityField {
     }
   }
 
-  /// The field as 4 floats per cell (x, y, z, 0).
-  const float* floats() const { return data_.empty() ? nullptr : data_[0].data(); }
+  /// The field as stride() floats per cell: (x, y, z, 0), or (x, y, z) on a frame's own array.
+  const float* floats() const { return frameValues_ ? frameValues_ : (data_.empty() ? nullptr : data_[0].data()); }
+  int stride() const { return frameValues_ ? 3 : 4; }
+  bool padded() const { return !frameValues_; }
 
  private:
+  const float* frameValues_ = nullptr;  ///< the frame's own u (layout Any, on a frame), else null
   std::vector<Eigen::Array4f> data_;
 };
 
@@ -74,15 +91,18 @@ class StepFields {
   void invalidate() { built_[0] = built_[1] = false; }
   /// u_P^rec (useGas false) or u_G^rec of the sampler's frames: the one built ahead for these frames,
   /// if any, else built now.
-  const StepVelocityField& velocity(const FrameSampler& sampler, bool useGas, bool parallel) {
+  /// With layout Any, a field already built padded this step is returned as it is; a padded request
+  /// after an Any one rebuilds the field in place.
+  const StepVelocityField& velocity(const FrameSampler& sampler, bool useGas, bool parallel,
+                                    StepFieldLayout layout = StepFieldLayout::Padded) {
     const int k = useGas ? 1 : 0;
-    if (!built_[k]) {
+    if (!built_[k] || (layout == StepFieldLayout::Padded && !fields_[k].padded())) {
       Ahead& a = ahead_[k];
       if (a.frame && a.frame.get() == &sampler.frame() && a.next.get() == sampler.nextFrame() &&
           a.blend == sampler.blend()) {
         std::swap(fields_[k], a.field);  // the same build(), done earlier
       } else {
-        fields_[k].build(sampler, useGas, parallel);
+        fields_[k].build(sampler, useGas, parallel, layout);
       }
       a.frame.reset(), a.next.reset();
       built_[k] = true;
@@ -119,8 +139,8 @@ class StepFields {
 class StepFieldSampler {
  public:
   StepFieldSampler(const StepVelocityField& field, const TrilinearLocator& locator)
-      : field_(field), locator_(locator), grid_(locator.constants()) {
-    corners_.set(locator.offsets32());
+      : values_(field.floats()), stride_(field.stride()), locator_(locator), grid_(locator.constants()) {
+    corners_.set(locator.offsets32(), stride_);
   }
   /// Grid coordinates of p in float (block::gridCoordinate()): where the motion kernel's u_P^rec
   /// samples and midpoints are taken.
@@ -133,7 +153,7 @@ class StepFieldSampler {
     float f[3];
     const std::int32_t base = grid_.locate(g.x(), g.y(), g.z(), f[0], f[1], f[2]);
     Eigen::Vector3f u;
-    block::interpolateCorners(field_.floats() + 4 * std::int64_t(base), corners_.off4, f[0], f[1], f[2], u.data());
+    block::interpolateCorners(values_ + stride_ * std::int64_t(base), corners_.off, f[0], f[1], f[2], u.data());
     return u;
   }
   /// The inverse grid spacing in float, per axis (midpoints in grid coordinates).
@@ -142,13 +162,14 @@ class StepFieldSampler {
   Eigen::Vector3d sample(const Eigen::Vector3d& p) const {
     const TrilinearStencil s = locator_.locate(p);
     float u[3];
-    block::interpolateCorners(field_.floats() + 4 * s.base, corners_.off4, float(s.f[0]), float(s.f[1]),
+    block::interpolateCorners(values_ + stride_ * s.base, corners_.off, float(s.f[0]), float(s.f[1]),
                               float(s.f[2]), u);
     return {double(u[0]), double(u[1]), double(u[2])};
   }
 
  private:
-  const StepVelocityField& field_;
+  const float* values_;  ///< the field's floats, taken when constructed
+  int stride_;
   const TrilinearLocator& locator_;
   block::GridConstants grid_;
   block::CornerOffsets corners_;

@@ -44,8 +44,8 @@ struct TracerContext {
   double blend = 0.0;                           ///< weight of nextFrame in [0, 1)
   FrameSampler sampler() const { return FrameSampler(grid, frame.get(), nextFrame.get(), blend); }
   /// u_P^rec or u_G^rec of this step as a step field (built on first use in the step).
-  const StepVelocityField& stepVelocity(bool useGas) {
-    return stepFields.velocity(sampler(), useGas, grid.cellCount() > kParallelThreshold);
+  const StepVelocityField& stepVelocity(bool useGas, StepFieldLayout layout = StepFieldLayout::Padded) {
+    return stepFields.velocity(sampler(), useGas, grid.cellCount() > kParallelThreshold, layout);
   }
   StepFields stepFields;  ///< invalidated whenever frame, nextFrame or blend change
 

@@ -186,7 +186,7 @@ TEST(Kernel, BlockSamplingEqualsTheScalarCombinationBitForBit) {
     }
     block::CornerOffsets corners;
     corners.set(locator.offsets32());
-    EXPECT_EQ(corners.adjacentX, shape[0] > 1);
+    EXPECT_EQ(corners.pairLoads, shape[0] > 1);
     std::uniform_real_distribution<double> px(-0.06, 0.05), py(-0.01, 0.1), pz(-0.01, 0.09);
     constexpr int n = block::kBlock;
     alignas(64) double x[n], y[n], z[n], ax[n], ay[n], az[n], ux[n], uy[n], uz[n];
@@ -202,7 +202,7 @@ TEST(Kernel, BlockSamplingEqualsTheScalarCombinationBitForBit) {
         const TrilinearStencil t = locator.locate(Eigen::Vector3d(x[k], y[k], z[k]));
         ASSERT_EQ(t.base, s.base[k]);
         float u[3];
-        block::interpolateCorners(field.data() + 4 * t.base, corners.off4, float(t.f[0]), float(t.f[1]),
+        block::interpolateCorners(field.data() + 4 * t.base, corners.off, float(t.f[0]), float(t.f[1]),
                                   float(t.f[2]), u);
         ASSERT_EQ(ux[k], double(u[0]) + ax[k]);
         ASSERT_EQ(uy[k], double(u[1]) + ay[k]);

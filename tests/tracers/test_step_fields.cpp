@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <random>
 
 #include "TracerTestSupport.hpp"
 #include "tracers/StepField.hpp"
@@ -91,4 +92,54 @@ TEST(StepFields, AFieldHoldsItsFramesValuesPaddedWithZero) {
     }
     EXPECT_EQ(wrong, 0u) << "useGas " << useGas;
   }
+}
+
+TEST(StepFields, LayoutAnyOnAFrameIsTheFrameItselfAndSamplesAlike) {
+  // Stages sampling a few points take a step on a frame as the frame's own 3 floats per cell; their
+  // samples (single points and blocks) equal the padded field's bit for bit.
+  const ThreeFrames t;
+  const auto f1 = t.db->frame(1), f2 = t.db->frame(2);
+  const FrameSampler onFrame(t.grid, f1.get());
+  StepFields fields;
+  const StepVelocityField& view = fields.velocity(onFrame, true, false, StepFieldLayout::Any);
+  EXPECT_EQ(view.floats(), f1->u_g.data());
+  EXPECT_EQ(view.stride(), 3);
+  const StepVelocityField padded = t.built(1, 1, 0.0, true);
+  ASSERT_EQ(padded.stride(), 4);
+  const TrilinearLocator& locator = onFrame.locator();
+  const StepFieldSampler a(view, locator), b(padded, locator);
+  constexpr int n = block::kBlock;
+  alignas(64) double x[n], y[n], z[n], ux[2][n], uy[2][n], uz[2][n];
+  alignas(64) static constexpr double kZero[n] = {};
+  std::mt19937_64 gen(5);
+  std::uniform_real_distribution<double> px(-0.01, 0.11), py(-0.01, 0.11), pz(-0.01, 0.06);  // some outside
+  for (int k = 0; k < n; ++k) x[k] = px(gen), y[k] = py(gen), z[k] = pz(gen);
+  block::BlockStencils s;
+  block::locateBlock(locator.constants(), n, x, y, z, s);
+  int r = 0;
+  for (const StepVelocityField* f : {&view, &padded}) {
+    block::CornerOffsets corners;
+    corners.set(locator.offsets32(), f->stride());
+    block::sampleBlock(f->floats(), corners, s, n, kZero, kZero, kZero, ux[r], uy[r], uz[r]);
+    ++r;
+  }
+  int differ = 0, moving = 0;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d p(x[k], y[k], z[k]);
+    differ += a.sample(p) != b.sample(p);
+    differ += ux[0][k] != ux[1][k] || uy[0][k] != uy[1][k] || uz[0][k] != uz[1][k];
+    differ += a.sample(p) != Eigen::Vector3d(ux[1][k], uy[1][k], uz[1][k]);
+    moving += ux[1][k] != 0.0;
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(moving, n / 2);  // the comparison sees values
+  // A padded request in the same step rebuilds it in place; a blend is always padded.
+  EXPECT_EQ(fields.velocity(onFrame, true, false).stride(), 4);
+  EXPECT_TRUE(t.equal(fields.velocity(onFrame, true, false), padded));
+  EXPECT_EQ(fields.velocity(onFrame, true, false, StepFieldLayout::Any).stride(), 4);  // already padded: kept
+  fields.invalidate();
+  const StepVelocityField& between =
+      fields.velocity(FrameSampler(t.grid, f1.get(), f2.get(), 0.25), true, false, StepFieldLayout::Any);
+  EXPECT_EQ(between.stride(), 4);
+  EXPECT_TRUE(t.equal(between, t.built(1, 2, 0.25, true)));
 }
