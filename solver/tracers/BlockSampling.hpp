@@ -39,8 +39,9 @@ struct BlockStencils {
   alignas(64) float ux[kBlock], uy[kBlock], uz[kBlock];
 };
 
-/// The combination of the 8 corners (corner c at field + off[c]; bit 0 of c is x, bit 1 y, bit 2 z) with fractions (fx, fy, fz): linear interpolation along z, then y, then x, each
-/// a + f (b - a) as one fused multiply-add in float. Exact for a uniform field. The scalar reference
+/// The combination of the 8 corners (corner c at field + off[c]; bit 0 of c is x, bit 1 y, bit 2 z)
+/// with fractions (fx, fy, fz): linear interpolation along z, then y, then x, each a + f (b - a) as
+/// one fused multiply-add in float. Exact for a uniform field. The scalar reference
 /// of sampleBlock().
 inline void interpolateCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
                                float out[3]) {

@@ -34,7 +34,8 @@ class StepVelocityField {
   /// Fills the field from the sampler's frame(s): u_P^rec, or u_G^rec when useGas. With layout Any, a
   /// step on a frame refers to the frame's array, which must outlive the field's use (the step's frames
   /// are held for the step: TracerContext, StepFields).
-  void build(const FrameSampler& sampler, bool useGas, bool parallel, StepFieldLayout layout = StepFieldLayout::Padded) {
+  void build(const FrameSampler& sampler, bool useGas, bool parallel,
+             StepFieldLayout layout = StepFieldLayout::Padded) {
     const auto& fa = useGas ? sampler.frame().u_g : sampler.frame().u_p;
     const FieldFrame* next = sampler.nextFrame();
     frameValues_ = nullptr;
