@@ -261,8 +261,10 @@ TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
   EXPECT_EQ(server->get("/v1/health").status, 200);
 }
 
-// Jobs of 12 simulated seconds (~5 s of wall time on an idle machine): long enough that the test sees
-// them RUNNING before they finish (2 s jobs finished within one progress interval when the machine was idle).
+// The job must still be running when the server dies, however fast the machine: once the solver has
+// written its first checkpoint, the test freezes it (SIGSTOP), kills the server, and only then lets it go
+// on (SIGCONT) to meet its PDEATHSIG. Waiting for a progress fraction instead raced the job's end: a
+// 12 s job takes 1 s of wall time on a fast machine, one progress interval.
 TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   std::string db, interrupted;
   pid_t solver = -1;
@@ -270,15 +272,20 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
     auto server = start(1);
     db = upload(*server);
     interrupted = submit(*server, sprayJob(db, 12.0, 5));
-    const auto running = pollJob(*server, interrupted, [](const nlohmann::json& j) {
-      return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0.1;
-    });
-    ASSERT_EQ(running.at("state"), "RUNNING") << running.dump(2);
-    ASSERT_LT(running.at("progress").at("fraction").get<double>(), 1.0);
-    const auto solvers = childrenOf(server->pid());
-    ASSERT_EQ(solvers.size(), 1u);
-    solver = solvers[0];
+    const auto checkpoint = tmp_->path() / "data" / "jobs" / interrupted / "checkpoint.h5";
+    for (int i = 0; i < 6000 && solver < 0; ++i) {
+      const auto solvers = childrenOf(server->pid());
+      if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0)
+        solver = solvers[0];
+      else
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen";
+    const auto running = server->get("/v1/jobs/" + interrupted).json();
+    ASSERT_EQ(running.at("state"), "RUNNING") << running.dump(2);  // frozen before it could finish
+    ASSERT_TRUE(processRunning(solver));
     server->stop(SIGKILL);  // the solver gets SIGTERM from the kernel (PDEATHSIG) and checkpoints
+    ASSERT_EQ(::kill(solver, SIGCONT), 0);
   }
   // The orphaned solver writes its checkpoint and exits; only then may a new server take the job.
   for (int i = 0; i < 400 && processRunning(solver); ++i)
