@@ -281,11 +281,14 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen";
-    const auto running = server->get("/v1/jobs/" + interrupted).json();
-    ASSERT_EQ(running.at("state"), "RUNNING") << running.dump(2);  // frozen before it could finish
-    ASSERT_TRUE(processRunning(solver));
+    const auto frozen = server->get("/v1/jobs/" + interrupted).json();
+    const bool alive = processRunning(solver);  // not a zombie that finished before the SIGSTOP
     server->stop(SIGKILL);  // the solver gets SIGTERM from the kernel (PDEATHSIG) and checkpoints
+    // Released before any assertion, so a failing one never leaves a stopped orphan behind.
     ASSERT_EQ(::kill(solver, SIGCONT), 0);
+    ASSERT_TRUE(alive);
+    ASSERT_EQ(frozen.at("state"), "RUNNING") << frozen.dump(2);
+    ASSERT_LT(frozen.at("progress").at("fraction").get<double>(), 1.0) << frozen.dump(2);
   }
   // The orphaned solver writes its checkpoint and exits; only then may a new server take the job.
   for (int i = 0; i < 400 && processRunning(solver); ++i)
