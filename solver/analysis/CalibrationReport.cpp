@@ -8,6 +8,7 @@
 
 #include "analysis/CalibrationFigures.hpp"
 #include "analysis/KsDistance.hpp"
+#include "analysis/StayComparison.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
 
@@ -58,6 +59,12 @@ std::vector<float> slice(const std::vector<float>& field, const CartesianGrid& g
 
 nlohmann::json optionalNumber(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 
+/// Real particles of the bed: bed mass over the mass of one particle.
+double realParticles(const Scene& scene) {
+  const auto& p = scene.particles;
+  return scene.process.bed_mass / (p.density * 3.14159265358979323846 / 6.0 * p.diameter * p.diameter * p.diameter);
+}
+
 }  // namespace
 
 int midplaneLayer(const Scene& scene, const CartesianGrid& grid) {
@@ -98,8 +105,11 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
   const std::size_t probe = figureProbe(in.scene);
   const std::size_t probes = in.scene.probes.size();
   const bool refRtd = in.reference.hasDurations(), refHoldup = in.reference.hasHoldup();
-  const WeightedSample refSample = WeightedSample::unweighted(in.reference.durations);
   const double refHoldupMean = in.reference.holdupMean();
+  // The members whose stays the reference counted: its own attribute, else the scene's real particles
+  // (one member each, as the tracers' holdup is counted).
+  const double refMembers = in.reference.members > 0.0 ? in.reference.members : realParticles(in.scene);
+  const double tracerPeriod = double(in.steps - in.discardSteps) * dt;
 
   std::vector<D0Scores> scores(n);
   std::vector<RunData> runs(n);
@@ -118,15 +128,17 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
     s.rtdMedian = rs.at("residence_time").at("median_s").get<double>();
     s.stays = rs.at("residence_time").at("stays").get<long long>();
 
+    s.instantaneousRms = rs.at("field_average").at("instantaneous_rms_difference").get<double>();
+    s.countingFloorRms = rs.at("field_average").at("counting_floor_rms").get<double>();
     d.durationCounts = r.readInt64s("/residence_time/duration_steps_counts");
     if (refRtd && s.stays > 0) {
-      WeightedSample sample;
-      for (std::size_t k = 0; k < d.durationCounts.size(); ++k) {
-        if (d.durationCounts[k] == 0) continue;
-        sample.values.push_back(double(k) * dt);
-        sample.weights.push_back(double(d.durationCounts[k]));
-      }
-      s.ksDistance = ksDistance(sample, refSample);
+      const StayComparison c = compareStays(d.durationCounts, dt, double(in.scene.rcfd.tracers), tracerPeriod,
+                                            in.reference.durations, refMembers, in.reference.recordedPeriod());
+      s.ksDistance = c.ksDistance;
+      if (std::isfinite(c.meanError())) s.rtdMeanRelativeError = c.meanError();
+      if (std::isfinite(c.crossingRateError())) s.crossingRateRelativeError = c.crossingRateError();
+      s.stays = (long long)(c.tracers.stays);
+      s.staysJson = c.toJson();
     }
     if (refHoldup && refHoldupMean > 0.0) s.holdupRelativeError = (s.holdupMean - refHoldupMean) / refHoldupMean;
 
@@ -194,6 +206,11 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
   out.write("/calibration/residence_time_mean_s", column([](const D0Scores& s) { return s.rtdMean; }));
   out.write("/calibration/residence_time_median_s", column([](const D0Scores& s) { return s.rtdMedian; }));
   out.write("/calibration/rtd_ks_distance", column([](const D0Scores& s) { return s.ksDistance.value_or(kNaN); }));
+  out.write("/calibration/rms_over_floor", column([](const D0Scores& s) { return s.rmsOverFloor(); }));
+  out.write("/calibration/residence_time_mean_relative_error",
+            column([](const D0Scores& s) { return s.rtdMeanRelativeError.value_or(kNaN); }));
+  out.write("/calibration/crossing_rate_relative_error",
+            column([](const D0Scores& s) { return s.crossingRateRelativeError.value_or(kNaN); }));
   out.write("/calibration/holdup_relative_error",
             column([](const D0Scores& s) { return s.holdupRelativeError.value_or(kNaN); }));
   out.setAttribute("/calibration", "selected_d0", scores[sel.selected].d0);
@@ -256,6 +273,12 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
                     {"residence_time_median_s", s.rtdMedian},
                     {"stays", s.stays},
                     {"rtd_ks_distance", optionalNumber(s.ksDistance)},
+                    {"residence_time_mean_relative_error", optionalNumber(s.rtdMeanRelativeError)},
+                    {"crossing_rate_relative_error", optionalNumber(s.crossingRateRelativeError)},
+                    {"instantaneous_rms_difference", s.instantaneousRms},
+                    {"counting_floor_rms", s.countingFloorRms},
+                    {"rms_over_floor", s.rmsOverFloor()},
+                    {"stay_comparison", s.staysJson},
                     {"field_rms_difference", s.fieldRms},
                     {"field_rms_difference_midplane", s.fieldRmsMidplane},
                     {"bed_shape_agrees", bool(sel.bedShapeAgrees[i])},
@@ -276,6 +299,11 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
     reference["residence_time_mean_s"] = sum / double(in.reference.durations.size());
     reference["residence_time_median_s"] = median(in.reference.durations);
     reference["stays"] = in.reference.durations.size();
+    reference["members"] = refMembers;
+    reference["members_from"] = in.reference.members > 0.0 ? "database" : "scene (bed mass / particle mass)";
+    reference["period_s"] = in.reference.recordedPeriod();
+    reference["residence_time_mean_on_tracer_lattice_s"] =
+        summariseStays(onStepLattice(in.reference.durations, dt), refMembers, in.reference.recordedPeriod()).mean_s;
   }
   if (refHoldup) reference["holdup_mean"] = refHoldupMean;
 
@@ -288,7 +316,9 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
                               {"field_rms_tolerance", in.options.fieldRmsTolerance},
                               {"ks_threshold", in.options.ksThreshold},
                               {"rtd_relative_tolerance", in.options.rtdRelativeTolerance},
-                              {"residence_times_judged_by", refRtd ? "ks_distance_to_reference" : "mean_relative_tolerance"}}},
+                              {"extend_sweep", in.options.extendSweep},
+                              {"at_upper_end", sel.atUpperEnd},
+                              {"residence_times_judged_by", refRtd ? "ks_mean_and_crossing_rate_on_the_tracer_lattice" : "mean_relative_tolerance"}}},
                             {"reference", reference},
                             {"probe_of_figure", fig.probeName},
                             {"midplane_layer", layer}};

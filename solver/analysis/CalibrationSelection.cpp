@@ -40,6 +40,11 @@ SelectionOptions selectionOptionsFrom(const nlohmann::json& job) {
   o.fieldRmsTolerance = option(c, "field_rms_tolerance", o.fieldRmsTolerance, 0.0, 10.0, false);
   o.ksThreshold = option(c, "ks_threshold", o.ksThreshold, 0.0, 1.0, true);
   o.rtdRelativeTolerance = option(c, "rtd_relative_tolerance", o.rtdRelativeTolerance, 0.0, 10.0, true);
+  if (c.contains("extend_sweep")) {
+    if (!c.at("extend_sweep").is_boolean()) throw InputError("job", "/calibration/extend_sweep", "must be true or false");
+    o.extendSweep = c.at("extend_sweep").get<bool>();
+  }
+  o.sweepFactor = option(c, "sweep_factor", o.sweepFactor, 1.0, 100.0, true);
   return o;
 }
 
@@ -53,50 +58,68 @@ Selection selectD0(const std::vector<D0Scores>& s, const SelectionOptions& o, bo
 
   Selection sel;
   sel.penaltyMinimum = order[0];
-  std::size_t bestField = order[0];
+  std::size_t bestShape = order[0];
   for (const std::size_t i : order) {
     if (s[i].penalty < s[sel.penaltyMinimum].penalty) sel.penaltyMinimum = i;
-    if (s[i].fieldRms < s[bestField].fieldRms) bestField = i;
+    if (s[i].rmsOverFloor() < s[bestShape].rmsOverFloor()) bestShape = i;
   }
-  const double fieldLimit = (1.0 + o.fieldRmsTolerance) * s[bestField].fieldRms;
-  const double rtdTarget = s[bestField].rtdMean;
+  const double shapeLimit = 1.0 + o.fieldRmsTolerance;
+  const double rtdTarget = s[bestShape].rtdMean;
+  auto within = [&](const std::optional<double>& e) { return e && std::abs(*e) <= o.rtdRelativeTolerance; };
   sel.bedShapeAgrees.assign(n, false);
   sel.residenceTimesAgree.assign(n, false);
   for (std::size_t i = 0; i < n; ++i) {
-    sel.bedShapeAgrees[i] = s[i].fieldRms <= fieldLimit;
+    sel.bedShapeAgrees[i] = s[i].countingFloorRms > 0.0 && s[i].rmsOverFloor() <= shapeLimit;
     if (s[i].stays == 0) continue;  // no completed stay: no residence-time distribution to compare
     if (useReference) {
-      sel.residenceTimesAgree[i] = s[i].ksDistance && *s[i].ksDistance <= o.ksThreshold;
+      sel.residenceTimesAgree[i] = s[i].ksDistance && *s[i].ksDistance <= o.ksThreshold &&
+                                   within(s[i].rtdMeanRelativeError) &&
+                                   (!s[i].crossingRateRelativeError || within(s[i].crossingRateRelativeError));
     } else {
       sel.residenceTimesAgree[i] = rtdTarget > 0.0 && std::abs(s[i].rtdMean - rtdTarget) <= o.rtdRelativeTolerance * rtdTarget;
     }
   }
-  const std::string bed = "bed shape (field RMS difference within " + g3(100.0 * o.fieldRmsTolerance) +
-                          "% of the best, " + g3(s[bestField].fieldRms) + ")";
-  const std::string rtd = useReference ? "residence times (KS distance to the reference <= " + g3(o.ksThreshold) + ")"
-                                       : "residence times (mean within " + g3(100.0 * o.rtdRelativeTolerance) +
-                                             "% of the best-shaped run's " + g3(rtdTarget) +
-                                             " s; no reference RTD)";
+  const std::string bed = "bed shape (instantaneous alpha_P RMS within " + g3(shapeLimit) +
+                          " x its counting floor)";
+  const std::string rtd =
+      useReference ? "residence times (KS distance <= " + g3(o.ksThreshold) + ", mean stay and crossing rate within " +
+                         g3(100.0 * o.rtdRelativeTolerance) + "% of the reference)"
+                   : "residence times (mean within " + g3(100.0 * o.rtdRelativeTolerance) + "% of the best-shaped run's " +
+                         g3(rtdTarget) + " s; no reference RTD)";
   const std::string penalty = "; the penalty minimum is at D0 = " + g3(s[sel.penaltyMinimum].d0) + " m2/s";
+  auto scores = [&](std::size_t i) {
+    std::string t = "RMS/floor " + g3(s[i].rmsOverFloor());
+    if (s[i].ksDistance) t += ", KS " + g3(*s[i].ksDistance);
+    if (s[i].rtdMeanRelativeError) t += ", mean stay " + g3(100.0 * *s[i].rtdMeanRelativeError) + "%";
+    if (s[i].crossingRateRelativeError) t += ", crossing rate " + g3(100.0 * *s[i].crossingRateRelativeError) + "%";
+    return t;
+  };
+  const std::size_t top = order.back();
+  bool found = false;
   for (const std::size_t i : order) {
     if (sel.bedShapeAgrees[i] && sel.residenceTimesAgree[i]) {
       sel.selected = i;
       sel.ruleSatisfied = true;
-      sel.reason = "D0 = " + g3(s[i].d0) + " m2/s is the lowest value whose " + bed + " and " + rtd +
-                   " agree (field RMS " + g3(s[i].fieldRms) +
-                   (s[i].ksDistance ? ", KS " + g3(*s[i].ksDistance) : std::string()) +
-                   ", mean residence time " + g3(s[i].rtdMean) + " s)" + penalty;
-      return sel;
-    }
-  }
-  for (const std::size_t i : order) {
-    if (sel.bedShapeAgrees[i]) {
-      sel.selected = i;
-      sel.reason = "no D0 met both criteria; D0 = " + g3(s[i].d0) + " m2/s is the lowest whose " + bed +
-                   " agrees, but no value met the " + rtd + " criterion" + penalty;
+      sel.reason = "D0 = " + g3(s[i].d0) + " m2/s is the lowest value whose " + bed + " and " + rtd + " agree (" +
+                   scores(i) + ")" + penalty;
+      found = true;
       break;
     }
   }
+  if (!found) {
+    // No D0 met both: the lowest whose bed shape agrees, else the best-shaped one.
+    sel.selected = bestShape;
+    for (const std::size_t i : order) {
+      if (sel.bedShapeAgrees[i]) {
+        sel.selected = i;
+        break;
+      }
+    }
+    sel.reason = "no D0 met both criteria; D0 = " + g3(s[sel.selected].d0) + " m2/s is the " +
+                 (sel.bedShapeAgrees[sel.selected] ? "lowest whose " + bed + " agrees" : "one with the best bed shape") +
+                 " (" + scores(sel.selected) + "), and no value met the " + rtd + " criterion" + penalty;
+  }
+  sel.atUpperEnd = n > 1 && (sel.selected == top || sel.penaltyMinimum == top);
   return sel;
 }
 

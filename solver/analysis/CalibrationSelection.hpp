@@ -23,19 +23,30 @@ struct D0Scores {
   double rtdMean = 0.0;            ///< mean spray-zone residence time [s]
   double rtdMedian = 0.0;          ///< [s]
   long long stays = 0;             ///< completed spray-zone stays counted
-  std::optional<double> ksDistance;           ///< RTD against the reference (when it exists)
+  double instantaneousRms = 0.0;   ///< RMS of alpha_P - alpha_P^rec over open cells and steps [-]
+  double countingFloorRms = 0.0;   ///< its floor for independently placed tracers (Poisson) [-]
+  std::optional<double> ksDistance;           ///< RTD against the reference on the tracers' lattice
   std::optional<double> holdupRelativeError;  ///< (holdup - reference) / reference
+  std::optional<double> rtdMeanRelativeError;      ///< mean stay against the reference's on the lattice
+  std::optional<double> crossingRateRelativeError; ///< stays per member per second against the reference's
+  nlohmann::json staysJson;        ///< the StayComparison (null without a reference)
+  double rmsOverFloor() const { return countingFloorRms > 0.0 ? instantaneousRms / countingFloorRms : 0.0; }
 };
 
 /// Thresholds of the paper's rule; scene-independent job options ("calibration" in the job file).
 struct SelectionOptions {
-  /// Bed shape agrees when fieldRms <= (1 + fieldRmsTolerance) x the lowest fieldRms of all D0.
+  /// Bed shape agrees when the instantaneous RMS difference is at most (1 + fieldRmsTolerance) x its
+  /// counting floor: the over-packing the motion adds is small against the noise of the tracer count.
   double fieldRmsTolerance = 0.25;
-  /// Residence times agree when the KS distance to the reference RTD is at most this.
-  double ksThreshold = 0.15;
-  /// Without a reference: mean residence time within this relative tolerance of the mean of the run
-  /// with the best bed shape.
+  /// Residence times agree when the KS distance to the reference RTD is at most this...
+  double ksThreshold = 0.10;
+  /// ...and the mean stay and the crossing rate are within this relative tolerance of the reference's
+  /// (without a reference: the mean within it of the best-shaped run's).
   double rtdRelativeTolerance = 0.10;
+  /// When the selection or the penalty minimum is the largest D0 of the sweep, extend the sweep by
+  /// factors of sweepFactor up to the D0 at which u_fluc_max binds (calibration job).
+  bool extendSweep = true;
+  double sweepFactor = 3.0;
 };
 
 /// Reads the optional "calibration" object of a job document (missing keys keep the defaults);
@@ -48,6 +59,8 @@ struct Selection {
   bool ruleSatisfied = false;      ///< false: no D0 met both criteria, fell back to bed shape only
   std::vector<bool> bedShapeAgrees, residenceTimesAgree;
   std::string reason;              ///< one line: why `selected`
+  /// The selection or the penalty minimum is the largest D0 of the list: the optimum may lie beyond.
+  bool atUpperEnd = false;
 };
 
 /// Applies both selections. `useReference`: judge residence times by the KS distance (every score

@@ -34,6 +34,18 @@ ReferenceStatistics readReferenceStatistics(const std::string& path) {
   h5::File f(path, h5::File::Mode::ReadOnly);
   if (f.exists(L::durations)) {
     r.durations = readNonNegative(f, path, L::durations);
+    // Optional attributes: absent ones stay 0 (unknown); present ones must be finite and > 0.
+    auto optionalAttribute = [&](const char* name) {
+      if (!f.hasAttribute(L::durations, name)) return 0.0;
+      const double v = f.doubleAttribute(L::durations, name);
+      if (!std::isfinite(v) || !(v > 0.0)) {
+        throw InputError(path, std::string(L::durations) + "@" + name, std::to_string(v) + "; must be > 0");
+      }
+      return v;
+    };
+    r.durationsDt = optionalAttribute("dt");
+    r.members = optionalAttribute(L::members);
+    r.period = optionalAttribute(L::period);
   } else {
     r.missing.push_back(L::durations);
   }

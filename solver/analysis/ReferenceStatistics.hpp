@@ -13,17 +13,26 @@ namespace reference_layout {
 inline constexpr const char* durations = "/reference/residence_time/durations_s";  ///< float64 [M]
 inline constexpr const char* holdup = "/reference/holdup/particles";               ///< float64 [T], attr dt
 inline constexpr const char* holdupDt = "dt";                                      ///< [s]
+/// Optional attributes of `durations`: the members (parcels) whose stays were recorded, and the length
+/// of the period they were recorded over [s] (crossing rates).
+inline constexpr const char* members = "members";
+inline constexpr const char* period = "period_s";
 }  // namespace reference_layout
 
 struct ReferenceStatistics {
   std::vector<double> durations;  ///< completed spray-zone stays [s]; empty if absent
   std::vector<double> holdup;     ///< spray-zone holdup series [particles]; empty if absent
   double holdupDt = 0.0;          ///< [s] between holdup samples
+  double durationsDt = 0.0;       ///< [s] sampling interval of the stays (attr dt of durations; 0: unknown)
+  double members = 0.0;           ///< members whose stays were recorded (0: unknown)
+  double period = 0.0;            ///< [s] over which they were recorded (0: unknown)
   std::vector<std::string> missing;  ///< datasets not found (their names from reference_layout)
 
   bool hasDurations() const { return !durations.empty(); }
   bool hasHoldup() const { return !holdup.empty(); }
   double holdupMean() const;
+  /// Length of the recording [s]: the attribute, else the holdup series' length (0: unknown).
+  double recordedPeriod() const { return period > 0.0 ? period : double(holdup.size()) * holdupDt; }
 };
 
 /// Reads the reference statistics of a database file. Absent datasets go into `missing`; present but

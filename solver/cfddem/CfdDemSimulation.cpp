@@ -150,6 +150,13 @@ std::vector<Eigen::Vector3d> CfdDemSimulation::particleVelocity() const {
   return map.meanVelocity(dem_->particles(), w);
 }
 
+coupling::VolumeMapping::VelocitySpread CfdDemSimulation::particleVelocitySpread() const {
+  const auto& map = coupling_->map();
+  std::vector<coupling::KernelWeights> w;
+  map.weightsOf(dem_->particles(), w);
+  return map.velocitySpread(dem_->particles(), w);
+}
+
 std::vector<Eigen::Vector3d> CfdDemSimulation::gasVelocity() const {
   if (gas_) return gas_->cellVelocity();
   return std::vector<Eigen::Vector3d>(std::size_t(grid_.cellCount()), Eigen::Vector3d::Zero());

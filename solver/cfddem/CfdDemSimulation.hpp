@@ -18,6 +18,7 @@
 
 #include "cfddem/DemFilling.hpp"
 #include "cfddem/DemSystem.hpp"
+#include "cfddem/coupling/VolumeMapping.hpp"
 #include "geometry/Apparatus.hpp"
 #include "geometry/CartesianGrid.hpp"
 #include "scene/Scene.hpp"
@@ -84,6 +85,9 @@ class CfdDemSimulation {
   std::vector<double> particleFraction() const;
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> particleVelocity() const;
+  /// The velocity spread of the same instant (VolumeMapping::velocitySpread): up share, the mean velocity
+  /// of the up- and down-moving volume, the variance per component.
+  coupling::VolumeMapping::VelocitySpread particleVelocitySpread() const;
   /// Gas velocity at cell centres, zero in closed cells and without gas [m/s].
   std::vector<Eigen::Vector3d> gasVelocity() const;
   /// Bed pressure drop: inlet minus outlet pressure [Pa], less the gas's own hydrostatic head

@@ -87,6 +87,9 @@ void ReferenceRecorder::write(h5::File& db) const {
   if (!durations.empty()) {
     db.write(L::durations, durations);
     db.setAttribute(L::durations, "dt", dt_);
+    // What a crossing rate (stays per member per second) divides by.
+    db.setAttribute(L::durations, L::members, double(stays_.members()));
+    db.setAttribute(L::durations, L::period, double(holdup_.size()) * dt_);
   }
   if (!holdup_.empty()) {
     std::vector<double> particles(holdup_.size()), parcels(holdup_.size());

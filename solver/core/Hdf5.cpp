@@ -202,6 +202,10 @@ void File::setAttribute(const std::string& object, const std::string& attr, cons
   writeAttribute(obj.id(), attr, type.id(), &ptr);
 }
 
+bool File::hasAttribute(const std::string& object, const std::string& attr) const {
+  Handle obj = openObject(file_.id(), object, path_);
+  return H5Aexists(obj.id(), attr.c_str()) > 0;
+}
 double File::doubleAttribute(const std::string& object, const std::string& attr) const {
   Handle obj = openObject(file_.id(), object, path_);
   Handle a(H5Aopen(obj.id(), attr.c_str(), H5P_DEFAULT), H5Aclose);

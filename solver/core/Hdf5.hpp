@@ -59,6 +59,7 @@ class File {
   void setAttribute(const std::string& object, const std::string& attr, double value);
   void setAttribute(const std::string& object, const std::string& attr, std::int64_t value);
   void setAttribute(const std::string& object, const std::string& attr, const std::string& value);
+  bool hasAttribute(const std::string& object, const std::string& attr) const;
   double doubleAttribute(const std::string& object, const std::string& attr) const;
   std::int64_t intAttribute(const std::string& object, const std::string& attr) const;
   std::string stringAttribute(const std::string& object, const std::string& attr) const;

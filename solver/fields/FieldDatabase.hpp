@@ -20,12 +20,46 @@ struct FieldFrame {
   std::vector<float> u_p;      ///< u_P, particle velocity [m/s], 3 per cell
   std::vector<float> u_g;      ///< u_G, gas velocity [m/s], 3 per cell
 
-  std::size_t bytes() const { return (alpha_p.size() + u_p.size() + u_g.size()) * sizeof(float); }
+  /// \name Velocity spread (optional, empty when absent or not loaded)
+  /// What the volume-weighted mean u_P loses where particles moving up and down share a cell. All
+  /// with the mapping weights of u_P, so up_fraction u_p_up + (1 - up_fraction) u_p_down = u_p.
+  ///@{
+  std::vector<float> up_fraction;   ///< share of the cell's particle volume with u_y > 0 [-], 1 per cell
+  std::vector<float> u_p_up;        ///< mean velocity of that volume [m/s], 3 per cell (u_p where none)
+  std::vector<float> u_p_down;      ///< mean velocity of the rest (u_y <= 0) [m/s], 3 per cell (u_p where none)
+  std::vector<float> u_p_variance;  ///< variance of each velocity component about u_p [m2/s2], 3 per cell
+  ///@}
+  bool hasVelocitySpread() const { return !up_fraction.empty(); }
+
+  std::size_t bytes() const {
+    return (alpha_p.size() + u_p.size() + u_g.size() + up_fraction.size() + u_p_up.size() + u_p_down.size() +
+            u_p_variance.size()) *
+           sizeof(float);
+  }
 };
+
+/// The optional per-frame datasets of the velocity spread: one list for the writer, the reader and
+/// the validation.
+struct OptionalFrameField {
+  const char* path;                      ///< dataset in the HDF5 layout
+  int components;                        ///< values per cell
+  std::vector<float> FieldFrame::*member;
+};
+inline const OptionalFrameField kVelocitySpreadFields[4] = {
+    {"/frames/up_fraction", 1, &FieldFrame::up_fraction},
+    {"/frames/u_p_up", 3, &FieldFrame::u_p_up},
+    {"/frames/u_p_down", 3, &FieldFrame::u_p_down},
+    {"/frames/u_p_variance", 3, &FieldFrame::u_p_variance}};
+/// Floats per cell of a frame: alpha_P, u_P, u_G, and the velocity spread when it is held.
+inline constexpr int kFrameFloatsPerCell = 7;
+inline constexpr int kVelocitySpreadFloatsPerCell = 10;
 
 /// How frames are served: all in RAM (cacheBytes == 0) or through an LRU cache of at most cacheBytes.
 struct FrameStorage {
   std::int64_t cacheBytes = 0;
+  /// Also read the velocity spread (kVelocitySpreadFields); an input error naming the dataset when the
+  /// file has none. Off: those datasets are not read and cost no memory.
+  bool velocitySpread = false;
 };
 
 struct FrameCacheStats {
@@ -70,8 +104,13 @@ class FieldDatabase {
   /// leaves an OpenMP region); std::out_of_range for a bad index.
   virtual std::shared_ptr<const FieldFrame> frame(int index) const = 0;
   virtual FrameCacheStats cacheStats() const = 0;
+  /// Whether the frames served carry the velocity spread (FieldFrame::hasVelocitySpread()).
+  virtual bool hasVelocitySpread() const = 0;
   /// Bytes of one frame in memory (FieldFrame::bytes()).
-  std::int64_t frameBytes() const { return grid().cellCount() * 7 * std::int64_t(sizeof(float)); }
+  std::int64_t frameBytes() const {
+    const int floats = kFrameFloatsPerCell + (hasVelocitySpread() ? kVelocitySpreadFloatsPerCell : 0);
+    return grid().cellCount() * floats * std::int64_t(sizeof(float));
+  }
 };
 
 /// A database held in memory only (no file): tests and benchmarks of other areas. Validated like a
@@ -86,6 +125,7 @@ std::shared_ptr<FieldDatabase> makeInMemoryDatabase(const CartesianGrid& grid,
 struct FieldDatabaseWriterOptions {
   int deflateLevel = 0;  ///< 0: no compression; 1-9: deflate level
   bool shuffle = false;  ///< byte shuffle before deflate
+  bool velocitySpread = false;  ///< write kVelocitySpreadFields (every appended frame must carry them)
 };
 
 /// Appends frames to a new database file; each append is flushed so the file stays readable.
@@ -111,6 +151,8 @@ class FieldDatabaseWriter {
   /// naming the dataset). After it returns the frame is on disk (H5Fflush).
   void append(const FieldFrame& frame);
   int framesWritten() const;
+  /// Whether appended frames must carry the velocity spread (created so, or reopened on such a file).
+  bool writesVelocitySpread() const;
   void close();
 
  private:

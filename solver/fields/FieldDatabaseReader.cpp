@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <mutex>
 
 #include "core/Errors.hpp"
@@ -26,6 +27,7 @@ struct Header {
   double dtRec = 0.0;
   int frames = 0;
   std::string scene;
+  bool velocitySpread = false;  ///< frames carry kVelocitySpreadFields
 };
 
 /// Frames held in memory: the RAM mode of a file and makeInMemoryDatabase().
@@ -52,6 +54,7 @@ class InRamDatabase final : public FieldDatabase {
   FrameCacheStats cacheStats() const override {
     return {hits_.load(std::memory_order_relaxed), 0, resident_};
   }
+  bool hasVelocitySpread() const override { return h_.velocitySpread; }
 
  private:
   Header h_;
@@ -64,6 +67,7 @@ class InRamDatabase final : public FieldDatabase {
 struct FrameReader {
   Handle file;
   Handle alphaP, uP, uG;
+  Handle spread[std::size(kVelocitySpreadFields)];  ///< read when valid (FrameStorage::velocitySpread)
   CartesianGrid grid;
   std::string path;
   mutable std::mutex io;
@@ -98,6 +102,10 @@ struct FrameReader {
       readPart(alphaP, layout::alphaP, index, 1, frame->alpha_p);
       readPart(uP, layout::uP, index, 3, frame->u_p);
       readPart(uG, layout::uG, index, 3, frame->u_g);
+      for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
+        const auto& f = kVelocitySpreadFields[k];
+        if (spread[k].valid()) readPart(spread[k], f.path, index, f.components, (*frame).*f.member);
+      }
     }
     checkFrame(*frame, index, grid, path);  // NaN/Inf: refused when the frame is read
     return frame;
@@ -123,6 +131,7 @@ class CachedDatabase final : public FieldDatabase {
     return cache_.get(index, [this](int i) { return reader_->read(i); });
   }
   FrameCacheStats cacheStats() const override { return cache_.stats(); }
+  bool hasVelocitySpread() const override { return h_.velocitySpread; }
 
  private:
   Header h_;
@@ -277,10 +286,24 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   reader->alphaP = openFloatDataset(reader->file, layout::alphaP, cell, v, &nA);
   reader->uP = openFloatDataset(reader->file, layout::uP, vec, v, &nP);
   reader->uG = openFloatDataset(reader->file, layout::uG, vec, v, &nG);
-  if (!v.empty()) refuse(path, std::move(v));
-  // Frames written completely: the shortest of the three datasets, and the writer's count if present
-  // (a writer interrupted inside a frame may have extended a dataset without filling it).
   hsize_t n = std::min({nA, nP, nG});
+  if (storage.velocitySpread) {
+    for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
+      const auto& f = kVelocitySpreadFields[k];
+      if (!hdf5::linkExists(reader->file, f.path)) {
+        v.push_back({f.path, "dataset is missing: the velocity spread (velocity_streams) needs it; the database "
+                             "job writes it, a database from elsewhere can add it (docs/formats.md)"});
+        continue;
+      }
+      hsize_t count = 0;
+      reader->spread[k] = openFloatDataset(reader->file, f.path, f.components == 1 ? cell : vec, v, &count);
+      n = std::min(n, count);
+    }
+    h.velocitySpread = true;
+  }
+  if (!v.empty()) refuse(path, std::move(v));
+  // Frames written completely: the shortest of the frame datasets, and the writer's count if present
+  // (a writer interrupted inside a frame may have extended a dataset without filling it).
   {
     Handle frames(H5Oopen(reader->file, layout::frames, H5P_DEFAULT));
     if (auto count = hdf5::readNumericAttribute(frames, layout::frameCountAttribute);
@@ -300,7 +323,8 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
     for (int i = 0; i < h.frames; ++i) frames[std::size_t(i)] = reader->read(i);
     return std::make_shared<InRamDatabase>(std::move(h), std::move(frames));  // closes the file
   }
-  const std::int64_t frameBytes = h.grid.cellCount() * 7 * std::int64_t(sizeof(float));
+  const int floats = kFrameFloatsPerCell + (h.velocitySpread ? kVelocitySpreadFloatsPerCell : 0);
+  const std::int64_t frameBytes = h.grid.cellCount() * floats * std::int64_t(sizeof(float));
   if (storage.cacheBytes < frameBytes) {
     throw InputError(path, "/rcfd/frame_cache_bytes",
                      std::to_string(storage.cacheBytes) + " bytes cannot hold one frame (" +
@@ -322,11 +346,17 @@ std::shared_ptr<FieldDatabase> makeInMemoryDatabase(const CartesianGrid& grid,
                                      std::to_string(layout::minimumFrames) + " are needed"});
   }
   if (!v.empty()) throw InputError(source, std::move(v));
-  Header h{source, grid, std::move(fluidFraction), dtRec, int(frames.size()), std::move(sceneJson)};
+  Header h{source, grid, std::move(fluidFraction), dtRec, int(frames.size()), std::move(sceneJson),
+           !frames.empty() && frames.front().hasVelocitySpread()};
   std::vector<std::shared_ptr<const FieldFrame>> shared;
   shared.reserve(frames.size());
   for (std::size_t i = 0; i < frames.size(); ++i) {
     checkFrame(frames[i], int(i), grid, source);
+    if (frames[i].hasVelocitySpread() != h.velocitySpread) {
+      throw InputError(source, kVelocitySpreadFields[0].path,
+                       "frame " + std::to_string(i) + (h.velocitySpread ? " lacks" : " has") +
+                           " the velocity spread that frame 0 " + (h.velocitySpread ? "has" : "lacks"));
+    }
     shared.push_back(std::make_shared<const FieldFrame>(std::move(frames[i])));
   }
   return std::make_shared<InRamDatabase>(std::move(h), std::move(shared));

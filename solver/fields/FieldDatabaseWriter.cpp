@@ -5,6 +5,7 @@
 // block readers after a crash).
 
 #include <cmath>
+#include <iterator>
 
 #include "core/Errors.hpp"
 #include "fields/FieldDatabase.hpp"
@@ -19,6 +20,8 @@ struct FieldDatabaseWriter::Impl {
   std::string path;
   CartesianGrid grid;
   Handle file, frames, alphaP, uP, uG;
+  Handle spread[std::size(kVelocitySpreadFields)];  ///< the velocity spread's datasets (invalid: not written)
+  bool withSpread = false;
   int written = 0;
 
   Handle createFrameSet(const char* name, int components, const FieldDatabaseWriterOptions& options) {
@@ -94,6 +97,12 @@ FieldDatabaseWriter::FieldDatabaseWriter(const std::string& path, const Cartesia
   s.alphaP = s.createFrameSet(layout::alphaP, 1, options);
   s.uP = s.createFrameSet(layout::uP, 3, options);
   s.uG = s.createFrameSet(layout::uG, 3, options);
+  s.withSpread = options.velocitySpread;
+  if (s.withSpread) {
+    for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
+      s.spread[k] = s.createFrameSet(kVelocitySpreadFields[k].path, kVelocitySpreadFields[k].components, options);
+    }
+  }
   hdf5::setInt64Attribute(s.frames, layout::frameCountAttribute, 0);
   hdf5::checkStatus(H5Fflush(s.file, H5F_SCOPE_GLOBAL), path + ": flush");
 }
@@ -133,6 +142,21 @@ std::unique_ptr<FieldDatabaseWriter> FieldDatabaseWriter::reopen(const std::stri
   s.alphaP = open(layout::alphaP, 1);
   s.uP = open(layout::uP, 3);
   s.uG = open(layout::uG, 3);
+  // The velocity spread goes on being written when the file has it (all of it: a part is a damaged file).
+  std::size_t spreadSets = 0;
+  for (const auto& f : kVelocitySpreadFields) spreadSets += hdf5::linkExists(s.file, f.path) ? 1 : 0;
+  if (spreadSets != 0 && spreadSets != std::size(kVelocitySpreadFields)) {
+    throw InputError(path, kVelocitySpreadFields[0].path, "the velocity spread is incomplete: " +
+                                                              std::to_string(spreadSets) + " of its " +
+                                                              std::to_string(std::size(kVelocitySpreadFields)) +
+                                                              " datasets exist");
+  }
+  s.withSpread = spreadSets != 0;
+  if (s.withSpread) {
+    for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
+      s.spread[k] = open(kVelocitySpreadFields[k].path, kVelocitySpreadFields[k].components);
+    }
+  }
   if (keepFrames < 0 || keepFrames > complete) {
     throw InputError(path, layout::frames, "holds " + std::to_string(complete) + " complete frames; cannot keep " +
                                                std::to_string(keepFrames));
@@ -142,6 +166,12 @@ std::unique_ptr<FieldDatabaseWriter> FieldDatabaseWriter::reopen(const std::stri
   hdf5::checkStatus(H5Dset_extent(s.alphaP, kept), path + ": shrinking " + layout::alphaP);
   hdf5::checkStatus(H5Dset_extent(s.uP, kept), path + ": shrinking " + layout::uP);
   hdf5::checkStatus(H5Dset_extent(s.uG, kept), path + ": shrinking " + layout::uG);
+  if (s.withSpread) {
+    for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
+      hdf5::checkStatus(H5Dset_extent(s.spread[k], kept),
+                        path + ": shrinking " + kVelocitySpreadFields[k].path);
+    }
+  }
   s.written = keepFrames;
   // A recurrence matrix computed on the old frames no longer describes the database.
   if (hdf5::linkExists(s.file, layout::recurrenceMatrix)) {
@@ -165,9 +195,21 @@ void FieldDatabaseWriter::append(const FieldFrame& frame) {
   Impl& s = *impl_;
   if (!s.file.valid()) throw RunError(s.path + ": append after close");
   checkFrame(frame, s.written, s.grid, s.path);
+  if (s.withSpread != frame.hasVelocitySpread()) {
+    throw InputError(s.path, kVelocitySpreadFields[0].path,
+                     std::string("frame ") + std::to_string(s.written) +
+                         (s.withSpread ? " carries no velocity spread; this database has one"
+                                       : " carries a velocity spread; this database was created without one"));
+  }
   s.appendPart(s.alphaP, layout::alphaP, 1, frame.alpha_p);
   s.appendPart(s.uP, layout::uP, 3, frame.u_p);
   s.appendPart(s.uG, layout::uG, 3, frame.u_g);
+  if (s.withSpread) {
+    for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
+      const auto& f = kVelocitySpreadFields[k];
+      s.appendPart(s.spread[k], f.path, f.components, frame.*f.member);
+    }
+  }
   ++s.written;
   // The count goes last: a reader trusts only frames the count covers.
   hdf5::setInt64Attribute(s.frames, layout::frameCountAttribute, s.written);
@@ -177,12 +219,15 @@ void FieldDatabaseWriter::append(const FieldFrame& frame) {
 
 int FieldDatabaseWriter::framesWritten() const { return impl_->written; }
 
+bool FieldDatabaseWriter::writesVelocitySpread() const { return impl_->withSpread; }
+
 void FieldDatabaseWriter::close() {
   Impl& s = *impl_;
   if (!s.file.valid()) return;
   s.alphaP.reset();
   s.uP.reset();
   s.uG.reset();
+  for (auto& h : s.spread) h.reset();
   s.frames.reset();
   const herr_t status = H5Fclose(s.file.release());
   if (status < 0) throw RunError(s.path + ": closing the database failed");

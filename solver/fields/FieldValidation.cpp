@@ -1,6 +1,9 @@
 #include "fields/FieldValidation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <cstdint>
 #include <cstring>
 #include <sstream>
@@ -89,9 +92,15 @@ void checkFrame(const FieldFrame& frame, int index, const CartesianGrid& grid, c
     const std::vector<float>* values;
     int components;
   };
-  const Part parts[3] = {{"/frames/alpha_p", &frame.alpha_p, 1},
-                         {"/frames/u_p", &frame.u_p, 3},
-                         {"/frames/u_g", &frame.u_g, 3}};
+  std::vector<Part> parts = {{"/frames/alpha_p", &frame.alpha_p, 1},
+                             {"/frames/u_p", &frame.u_p, 3},
+                             {"/frames/u_g", &frame.u_g, 3}};
+  // The velocity spread: all of it or none.
+  const bool spread = std::any_of(std::begin(kVelocitySpreadFields), std::end(kVelocitySpreadFields),
+                                  [&](const OptionalFrameField& f) { return !(frame.*f.member).empty(); });
+  if (spread) {
+    for (const auto& f : kVelocitySpreadFields) parts.push_back({f.path, &(frame.*f.member), f.components});
+  }
   for (const auto& p : parts) {
     if (std::int64_t(p.values->size()) != cells * p.components) {
       violations.push_back({p.name, "frame " + std::to_string(index) + " has " +
@@ -109,6 +118,32 @@ void checkFrame(const FieldFrame& frame, int index, const CartesianGrid& grid, c
                                         std::to_string(ijk[2]) + ") holds " +
                                         str((*p.values)[std::size_t(bad)]) +
                                         "; every value must be finite"});
+    }
+  }
+  if (spread && violations.empty()) {
+    // Shares in [0, 1] and variances >= 0, within float rounding of the writer's arithmetic.
+    auto firstOutside = [](const std::vector<float>& values, float lo, float hi) -> std::int64_t {
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        if (!(values[i] >= lo && values[i] <= hi)) return std::int64_t(i);
+      }
+      return -1;
+    };
+    const float inf = std::numeric_limits<float>::infinity();
+    const struct {
+      const char* name;
+      const std::vector<float>* values;
+      int components;
+      float lo, hi;
+      const char* rule;
+    } ranges[2] = {{"/frames/up_fraction", &frame.up_fraction, 1, 0.0f, 1.0f, "must be in [0, 1]"},
+                   {"/frames/u_p_variance", &frame.u_p_variance, 3, 0.0f, inf, "must be >= 0"}};
+    for (const auto& r : ranges) {
+      const std::int64_t bad = firstOutside(*r.values, r.lo, r.hi);
+      if (bad < 0) continue;
+      const auto ijk = grid.cellIjk(bad / r.components);
+      violations.push_back({r.name, "frame " + std::to_string(index) + ", cell (" + std::to_string(ijk[0]) + ", " +
+                                        std::to_string(ijk[1]) + ", " + std::to_string(ijk[2]) + ") holds " +
+                                        str((*r.values)[std::size_t(bad)]) + "; it " + r.rule});
     }
   }
   if (!violations.empty()) throw InputError(source, std::move(violations));

@@ -26,6 +26,7 @@
 #include "jobs/JobRunner.hpp"
 #include "jobs/Progress.hpp"
 #include "jobs/RecurrenceSetup.hpp"
+#include "tracers/FluctuationModel.hpp"
 #include "tracers/TracerSimulation.hpp"
 
 namespace rcfd {
@@ -35,10 +36,20 @@ namespace fs = std::filesystem;
 
 /// The paper's range of D0 values [m2/s], used when the job gives none.
 const std::vector<double> kDefaultD0 = {0.0, 1e-5, 1e-4, 5e-4, 1e-3, 1e-2};
-/// Effects of every calibration run, whatever the scene lists.
+/// Effects of every calibration run, whatever the scene lists...
 const std::vector<std::string> kCalibrationEffects = {"transport", "fluctuation",   "free_flight",
                                                       "walls",     "tracer_volume_fraction", "probes",
                                                       "residence_time", "field_average"};
+/// ...and the motion models of the scene's list that change how tracers move (calibrated with them).
+const std::vector<std::string> kCalibratedModels = {"velocity_streams"};
+
+std::vector<std::string> calibrationEffects(const Scene& scene) {
+  std::vector<std::string> effects = kCalibrationEffects;
+  for (const auto& m : kCalibratedModels) {
+    if (scene.hasEffect(m)) effects.push_back(m);
+  }
+  return effects;
+}
 
 int threadBudget() {
 #ifdef _OPENMP
@@ -79,7 +90,7 @@ class CalibrationJob final : public JobRunner {
     if (scene.probes.empty()) {
       throw InputError("job", "/scene/probes", "a calibration needs at least one probe for the penalty score");
     }
-    const std::vector<double> d0 = job.d0_values.empty() ? kDefaultD0 : job.d0_values;
+    std::vector<double> d0 = job.d0_values.empty() ? kDefaultD0 : job.d0_values;
     std::set<double> seen;
     for (std::size_t i = 0; i < d0.size(); ++i) {
       const std::string pointer = "/d0_values/" + std::to_string(i);
@@ -104,20 +115,20 @@ class CalibrationJob final : public JobRunner {
     if (fs::exists(runsDir + "/prior_wall_time_s")) std::ifstream(runsDir + "/prior_wall_time_s") >> priorWall;
 
     // --- the D0 runs ---
-    const std::size_t n = d0.size();
     std::atomic<std::int64_t> stepsThisProcess{0}, stepsDone{0};
     std::atomic<bool> stop{false};
     std::mutex mutex;  // progress reporter and the first error
     std::exception_ptr error;
     ProgressReporter progress(options.progressJson, options.progressInterval, "calibration ");
     progress.setPriorWallTime(priorWall);
-    const double totalSteps = double(steps) * double(n);
+    double totalSteps = double(steps) * double(d0.size());
 
     auto runOne = [&](std::size_t i) -> RunOutcome {
       const std::string dir = runsDir + "/d0_" + std::to_string(i);
       const nlohmann::json key = {{"d0", d0[i]},          {"seed", job.seed},       {"steps", steps},
                                   {"discard_steps", discardSteps}, {"tracers", scene.rcfd.tracers},
-                                  {"dt", scene.rcfd.dt},  {"database", job.database}};
+                                  {"dt", scene.rcfd.dt},  {"database", job.database},
+                                  {"effects", calibrationEffects(scene)}};
       if (fs::exists(dir + "/key.json") && readJson(dir + "/key.json") != key) {
         spdlog::warn("{} holds a run of other settings; starting D0 = {} afresh", dir, d0[i]);
         fs::remove_all(dir);
@@ -131,7 +142,7 @@ class CalibrationJob final : public JobRunner {
 
       Scene s = scene;
       s.rcfd.d0 = d0[i];
-      s.effects = kCalibrationEffects;
+      s.effects = calibrationEffects(scene);
       TracerSimulation sim(s, rec.database, rec.path, TracerRunSettings{job.seed, steps, discardSteps});
       const std::string checkpoint = dir + "/checkpoint.h5";
       if (fs::exists(checkpoint)) {
@@ -179,36 +190,70 @@ class CalibrationJob final : public JobRunner {
       }
     };
 
-    const int budget = std::max(1, threadBudget());
-    const int workers = parallelOverD0 ? int(std::min<std::size_t>(std::size_t(budget), n)) : 1;
-    const int threadsPerRun = std::max(1, budget / workers);
-    spdlog::info("calibration: {} D0 values x {} steps; {} run(s) at a time with {} thread(s) each", n, steps,
-                 workers, threadsPerRun);
-    if (workers <= 1) {
-      for (std::size_t i = 0; i < n && !stop; ++i) guarded(i);
-    } else {
-      std::atomic<std::size_t> next{0};
-      std::vector<std::thread> pool;
-      for (int w = 0; w < workers; ++w) {
-        pool.emplace_back([&] {
-          setRunThreads(threadsPerRun);
-          for (std::size_t i = next++; i < n && !stop; i = next++) guarded(i);
-        });
+    // Runs [first, last) of the list, in parallel over the thread budget.
+    auto runRange = [&](std::size_t first, std::size_t last) {
+      const std::size_t count = last - first;
+      const int budget = std::max(1, threadBudget());
+      const int workers = parallelOverD0 ? int(std::min<std::size_t>(std::size_t(budget), count)) : 1;
+      const int threadsPerRun = std::max(1, budget / workers);
+      spdlog::info("calibration: {} D0 values x {} steps; {} run(s) at a time with {} thread(s) each", count, steps,
+                   workers, threadsPerRun);
+      if (workers <= 1) {
+        for (std::size_t i = first; i < last && !stop; ++i) guarded(i);
+      } else {
+        std::atomic<std::size_t> next{first};
+        std::vector<std::thread> pool;
+        for (int w = 0; w < workers; ++w) {
+          pool.emplace_back([&] {
+            setRunThreads(threadsPerRun);
+            for (std::size_t i = next++; i < last && !stop; i = next++) guarded(i);
+          });
+        }
+        for (auto& t : pool) t.join();
       }
-      for (auto& t : pool) t.join();
-    }
-    const double wall = priorWall + progress.wallTime();
-    if (error) std::rethrow_exception(error);
-    if (stop) {
-      writeFileAtomically(runsDir + "/prior_wall_time_s", std::to_string(wall) + "\n");
-      throw Cancelled("calibration stopped; finished D0 runs and checkpoints are kept in " + runsDir);
-    }
-    progress.report(1.0, totalSteps * scene.rcfd.dt, true);
+      const double wall = priorWall + progress.wallTime();
+      if (error) std::rethrow_exception(error);
+      if (stop) {
+        writeFileAtomically(runsDir + "/prior_wall_time_s", std::to_string(wall) + "\n");
+        throw Cancelled("calibration stopped; finished D0 runs and checkpoints are kept in " + runsDir);
+      }
+    };
 
-    // --- scores, selection, result.h5 and figures ---
-    analysis::CalibrationInputs inputs{scene, *rec.database, d0, runsDir, reference, selection, steps, discardSteps};
-    nlohmann::json summary = analysis::writeCalibrationReport(inputs, options.outDir + "/result.h5",
-                                                             scene.outputs.svg ? options.outDir : std::string());
+    // --- runs, scores and selection; the sweep grows while its optimum lies at its upper end ---
+    // Beyond the D0 at which Eq. (10)'s largest speed reaches u_fluc_max the cap decides, not D0.
+    const double bindingD0 = [&] {
+      const auto model = FluctuationModelRegistry::create(scene.rcfd.fluctuation_model);
+      const double unit = model->speed(1.0, 0.0, 1.0, scene.rcfd.dt);  // the largest speed at D0 = 1
+      return unit > 0.0 ? std::pow(scene.rcfd.u_fluc_max / unit, 2) : 0.0;
+    }();
+    nlohmann::json summary;
+    nlohmann::json extension = {{"added", nlohmann::json::array()}, {"binding_d0", bindingD0}};
+    for (std::size_t first = 0;;) {
+      runRange(first, d0.size());
+      first = d0.size();
+      analysis::CalibrationInputs inputs{scene, *rec.database, d0, runsDir, reference, selection, steps, discardSteps};
+      summary = analysis::writeCalibrationReport(inputs, options.outDir + "/result.h5",
+                                                 scene.outputs.svg ? options.outDir : std::string());
+      if (!summary["selection"]["at_upper_end"].get<bool>()) break;
+      const double top = *std::max_element(d0.begin(), d0.end());
+      if (!selection.extendSweep) {
+        extension["stopped"] = "the optimum is at the largest D0 of the sweep; extend_sweep is off";
+        break;
+      }
+      if (!(top < bindingD0 * (1.0 - 1e-9))) {
+        extension["stopped"] = "the optimum is at the largest D0 of the sweep, where u_fluc_max already binds: "
+                               "a larger D0 changes nothing";
+        break;
+      }
+      const double next = std::min(bindingD0, top > 0.0 ? top * selection.sweepFactor : 1e-5);
+      spdlog::info("calibration: the optimum is at the upper end of the sweep (D0 = {} m2/s); adding D0 = {} m2/s",
+                   top, next);
+      d0.push_back(next);
+      extension["added"].push_back(next);
+      totalSteps = double(steps) * double(d0.size());
+    }
+    summary["sweep_extension"] = extension;
+    progress.report(1.0, totalSteps * scene.rcfd.dt, true);
     {
       h5::File out(options.outDir + "/result.h5", h5::File::Mode::ReadWrite);
       out.write("/path/frames", std::vector<std::int64_t>(rec.path.frames.begin(), rec.path.frames.end()));
@@ -221,7 +266,7 @@ class CalibrationJob final : public JobRunner {
     summary["discard_s"] = double(discardSteps) * scene.rcfd.dt;
     summary["dt"] = scene.rcfd.dt;
     summary["tracers"] = scene.rcfd.tracers;
-    summary["effects"] = kCalibrationEffects;
+    summary["effects"] = calibrationEffects(scene);
     summary["path"] = {{"jumps", rec.pathStats.jumps},
                        {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},
                        {"mean_sequence_frames", rec.pathStats.meanSequenceLength}};

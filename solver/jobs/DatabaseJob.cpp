@@ -46,18 +46,25 @@ std::vector<std::string> cfdDemEffects(const Scene& scene) {
   return out;
 }
 
+std::vector<float> interleaved(const std::vector<Eigen::Vector3d>& values) {
+  std::vector<float> out(3 * values.size());
+  for (std::size_t c = 0; c < values.size(); ++c)
+    for (int d = 0; d < 3; ++d) out[3 * c + std::size_t(d)] = float(values[c][d]);
+  return out;
+}
+
+/// A frame of the current instant, with the velocity spread (what velocity_streams reads).
 FieldFrame sampleFrame(const CfdDemSimulation& sim) {
   FieldFrame f;
   const auto alpha = sim.particleFraction();
-  const auto up = sim.particleVelocity();
-  const auto ug = sim.gasVelocity();
+  const auto spread = sim.particleVelocitySpread();
   f.alpha_p.assign(alpha.begin(), alpha.end());
-  f.u_p.resize(3 * up.size());
-  f.u_g.resize(3 * ug.size());
-  for (std::size_t c = 0; c < up.size(); ++c)
-    for (int d = 0; d < 3; ++d) f.u_p[3 * c + std::size_t(d)] = float(up[c][d]);
-  for (std::size_t c = 0; c < ug.size(); ++c)
-    for (int d = 0; d < 3; ++d) f.u_g[3 * c + std::size_t(d)] = float(ug[c][d]);
+  f.u_p = interleaved(spread.mean);
+  f.u_g = interleaved(sim.gasVelocity());
+  f.up_fraction.assign(spread.upFraction.begin(), spread.upFraction.end());
+  f.u_p_up = interleaved(spread.up);
+  f.u_p_down = interleaved(spread.down);
+  f.u_p_variance = interleaved(spread.variance);
   return f;
 }
 
@@ -143,7 +150,10 @@ class DatabaseJob final : public JobRunner {
       st.settled = true;
       st.settledStep = sim.demStep();
       makeRecorder();
-      writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(), scene.source_json);
+      FieldDatabaseWriterOptions writeOptions;
+      writeOptions.velocitySpread = true;
+      writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(), scene.source_json,
+                                                     writeOptions);
       progress->report(fraction(), sim.time(), true);
       startProgress();
       if (cancellationRequested() || options.stopAfterSteps == 0) cancelled("after settling");
@@ -159,7 +169,11 @@ class DatabaseJob final : public JobRunner {
       // Events at the current instant first: a checkpoint taken after a step resumes here.
       const std::int64_t offset = sim.demStep() - st.settledStep;
       if (st.framesWritten < plan.frames && offset == plan.frameOffset(st.framesWritten)) {
-        writer->append(sampleFrame(sim));
+        FieldFrame frame = sampleFrame(sim);
+        if (!writer->writesVelocitySpread()) {  // a database begun by a version without it: keep it uniform
+          for (const auto& f : kVelocitySpreadFields) (frame.*f.member).clear();
+        }
+        writer->append(frame);
         ++st.framesWritten;
       }
       if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/Errors.hpp"
+#include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
 
@@ -22,7 +23,8 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
       setup.matrixWasStored = true;
     }
   }
-  setup.database = FieldDatabase::open(databasePath, FrameStorage{scene.rcfd.frame_cache_bytes});
+  const FrameStorage storage{scene.rcfd.frame_cache_bytes, TracerEffectRegistry::needsVelocitySpread(scene.effects)};
+  setup.database = FieldDatabase::open(databasePath, storage);
   if (!setup.matrixWasStored) {
     setup.matrix = computeRecurrenceMatrix(*setup.database);
     spdlog::info("recurrence matrix of {} frames computed in {:.2f} s", setup.database->frameCount(),
@@ -35,7 +37,7 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
     } catch (const std::exception& e) {
       spdlog::warn("could not store the recurrence matrix in {}: {}", databasePath, e.what());
     }
-    if (!setup.database) setup.database = FieldDatabase::open(databasePath, FrameStorage{scene.rcfd.frame_cache_bytes});
+    if (!setup.database) setup.database = FieldDatabase::open(databasePath, storage);
   }
   if (!PathGeneratorRegistry::contains(scene.rcfd.path.type)) {
     throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));

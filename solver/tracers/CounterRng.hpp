@@ -28,6 +28,7 @@ enum class RngPurpose : std::uint64_t {
   Path = 4,
   Test = 5,
   Deposition = 6,
+  Streams = 7,
 };
 
 /// The part of a CounterRng key shared by every stream of one (seed, purpose, step), hoisted out of

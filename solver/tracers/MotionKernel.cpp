@@ -270,6 +270,10 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   double* const pvz = cloud.vz.data();
   const float* cellData = cellData_.data();
   const std::int32_t* const ids = cloud.id.data();
+  const bool streams = ctx.streamVelocity[0].size() == cloud.size();
+  const float* const streamX = ctx.streamVelocity[0].data();
+  const float* const streamY = ctx.streamVelocity[1].data();
+  const float* const streamZ = ctx.streamVelocity[2].data();
   const bool vectorised = settings_.vectorised;
   // Dynamic chunks of blocks: sub-stepped and near-wall tracers cluster (in the spout, at the walls), so
   // equal shares of blocks are not equal work. Lanes with sub-steps left after their first are
@@ -353,6 +357,11 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
         }
       } else {
         for (int k = 0; k < count; ++k) ax[k] = ay[k] = az[k] = 0.0f;
+      }
+      // The tracer's stream velocity relative to u_P^rec (velocity_streams), held over the step as u_fluc is.
+      if (streams) {
+  #pragma omp simd
+        for (int k = 0; k < count; ++k) ax[k] += streamX[i0 + k], ay[k] += streamY[i0 + k], az[k] += streamZ[i0 + k];
       }
       if (!vectorised) {
         for (int k = 0; k < count; ++k) {

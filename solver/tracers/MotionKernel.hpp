@@ -1,7 +1,8 @@
 #pragma once
 /// \file MotionKernel.hpp
 /// Moves every tracer through one rCFD step: Eq. (9) transport with the Eq. (10) fluctuation, free
-/// flight under single-sphere drag and gravity where alpha_P^rec is below free_flight_alpha, and
+/// flight under single-sphere drag and gravity where alpha_P^rec is below free_flight_alpha, the
+/// stream velocity of velocity_streams (TracerContext::streamVelocity) where given, and
 /// reflection at the apparatus's exact walls. Tracers faster than one cell per step are sub-stepped
 /// (particle Courant number <= max_courant). Each tracer is independent and draws from its own
 /// counter-based random stream, so results are bit-identical for any thread count.

@@ -60,6 +60,11 @@ struct TracerContext {
   std::vector<std::int32_t> nextTracerCell;
   std::int64_t nextTracerCellStep = -1;
 
+  // Provided by `velocity_streams` (empty otherwise): per tracer index, the velocity of the tracer's
+  // stream relative to u_P^rec, u_stream - u_P^rec of its cell [m/s] (x, y, z arrays), which the motion
+  // kernel adds to Eq. (9) over the step.
+  std::vector<float> streamVelocity[3];
+
   // Provided by `spray` (null otherwise); `deposition` adds per-cell and per-tracer arrays to it.
   std::shared_ptr<SprayState> spray;
 

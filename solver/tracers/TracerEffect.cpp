@@ -19,9 +19,9 @@ std::string validNames() {
 }  // namespace
 
 bool TracerEffectRegistry::add(const std::string& name, std::vector<std::string> needs, int order,
-                               std::string doc, Factory factory) {
-  auto [it, inserted] =
-      table().emplace(name, Entry{std::move(doc), std::move(needs), order, std::move(factory)});
+                               std::string doc, Factory factory, bool readsVelocitySpread) {
+  auto [it, inserted] = table().emplace(
+      name, Entry{std::move(doc), std::move(needs), order, std::move(factory), readsVelocitySpread});
   if (!inserted) throw std::logic_error("tracer effect registered twice: " + name);
   return true;
 }
@@ -58,6 +58,13 @@ std::vector<std::string> TracerEffectRegistry::resolve(const std::vector<std::st
     return ea.order != eb.order ? ea.order < eb.order : a < b;
   });
   return chosen;
+}
+
+bool TracerEffectRegistry::needsVelocitySpread(const std::vector<std::string>& effects) {
+  return std::any_of(effects.begin(), effects.end(), [](const std::string& name) {
+    const auto it = table().find(name);
+    return it != table().end() && it->second.readsVelocitySpread;
+  });
 }
 
 bool isTracerStageEffect(const std::string& name) {

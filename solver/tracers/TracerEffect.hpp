@@ -75,16 +75,20 @@ class TracerEffectRegistry {
     std::vector<std::string> needs;
     int order = 0;  ///< position in the step among independent effects (lower first)
     Factory factory;
+    bool readsVelocitySpread = false;  ///< reads the frames' velocity spread (FrameStorage::velocitySpread)
   };
 
   static bool add(const std::string& name, std::vector<std::string> needs, int order, std::string doc,
-                  Factory factory);
+                  Factory factory, bool readsVelocitySpread = false);
   static const std::map<std::string, Entry>& entries();
   static bool contains(const std::string& name);
 
   /// Checks a scene's tracer-stage effect list: every name known, every dependency present. Returns the
   /// names in execution order. Throws InputError naming /effects and listing the valid names.
   static std::vector<std::string> resolve(const std::vector<std::string>& requested);
+  /// Whether any of the listed effects reads the frames' velocity spread: the database is then opened
+  /// with it (and without it otherwise, so that it costs no memory).
+  static bool needsVelocitySpread(const std::vector<std::string>& effects);
 };
 
 /// Effect names of the other stages (CFD-DEM, spray) that a tracer run ignores.

@@ -143,7 +143,26 @@ TEST(CalibrationJob, RelaxationLowersThePenaltyAndEveryD0IsReported) {
   const json s = run(job, dir / "out");
   EXPECT_EQ(s["kind"], "calibration");
   EXPECT_EQ(s["status"], "succeeded");
-  ASSERT_EQ(s["d0"].size(), 3u);
+  // The penalty falls up to the largest D0 of the list: the sweep is extended (x3) up to the D0 at which
+  // u_fluc_max binds, 6 pi dt u_fluc_max^2 = 0.0942 m2/s for Eq. (10), and says so.
+  const double binding = 6.0 * 3.14159265358979323846 * kDt * 1.0;
+  EXPECT_NEAR(s["sweep_extension"]["binding_d0"].get<double>(), binding, 1e-12);
+  const json& added = s["sweep_extension"]["added"];
+  ASSERT_GE(added.size(), 1u) << s["sweep_extension"].dump();
+  EXPECT_NEAR(added[0].get<double>(), 3e-2, 1e-15);
+  for (std::size_t k = 1; k < added.size(); ++k) {
+    EXPECT_NEAR(added[k].get<double>(), std::min(binding, 3.0 * added[k - 1].get<double>()), 1e-12);
+  }
+  // It stopped because the optimum now lies inside the sweep, or because the cap binds.
+  if (s["sweep_extension"].contains("stopped")) {
+    EXPECT_NEAR(added.back().get<double>(), binding, 1e-12);
+    EXPECT_NE(s["sweep_extension"]["stopped"].get<std::string>().find("u_fluc_max already binds"), std::string::npos);
+  } else {
+    EXPECT_FALSE(s["selection"]["at_upper_end"].get<bool>());
+    EXPECT_LT(s["selected_d0"].get<double>(), added.back().get<double>());
+  }
+  const std::size_t runs = 3 + added.size();
+  ASSERT_EQ(s["d0"].size(), runs);
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(s["d0"][i]["value"].get<double>(), job.d0_values[i]);
     for (const char* key : {"penalty", "holdup_mean", "residence_time_mean_s", "field_rms_difference"}) {
@@ -152,8 +171,8 @@ TEST(CalibrationJob, RelaxationLowersThePenaltyAndEveryD0IsReported) {
   }
   const double selected = s["selected_d0"].get<double>();
   std::size_t sel = 0;
-  while (sel < 3 && job.d0_values[sel] != selected) ++sel;
-  ASSERT_LT(sel, 3u) << "selected_d0 " << selected << " is not one of the values";
+  while (sel < runs && s["d0"][sel]["value"].get<double>() != selected) ++sel;
+  ASSERT_LT(sel, runs) << "selected_d0 " << selected << " is not one of the values";
   EXPECT_GT(selected, 0.0);
   EXPECT_GT(s["d0"][0]["penalty"].get<double>(), s["d0"][sel]["penalty"].get<double>());
   // Without relaxation the bed keeps its frame-0 shape: the field error is far above the relaxed one.
@@ -165,7 +184,9 @@ TEST(CalibrationJob, RelaxationLowersThePenaltyAndEveryD0IsReported) {
   EXPECT_EQ(s["effects"].size(), 8u);
   // Outputs: result.h5 datasets, the figures, summary.json on disk.
   h5::File r((dir / "out/result.h5").string(), h5::File::Mode::ReadOnly);
-  EXPECT_EQ(r.readDoubles("/calibration/d0"), job.d0_values);
+  std::vector<double> all = job.d0_values;
+  for (const auto& a : added) all.push_back(a.get<double>());
+  EXPECT_EQ(r.readDoubles("/calibration/d0"), all);
   EXPECT_EQ(r.doubleAttribute("/calibration", "selected_d0"), selected);
   EXPECT_EQ(r.shape("/calibration/runs/d0_1/probes/alpha_p_tracers")[1], 3u);
   EXPECT_EQ(r.readDoubles("/calibration/runs/d0_1/holdup/particles").size(), std::size_t(kSteps - 100));
@@ -212,7 +233,7 @@ TEST(CalibrationJob, ReferenceStatisticsAreUsed) {
   const json s = run(job, dir / "second");
   EXPECT_TRUE(s["reference"]["available"].get<bool>());
   EXPECT_TRUE(s["reference"]["scores_not_computed"].empty());
-  EXPECT_EQ(s["selection"]["residence_times_judged_by"], "ks_distance_to_reference");
+  EXPECT_EQ(s["selection"]["residence_times_judged_by"], "ks_mean_and_crossing_rate_on_the_tracer_lattice");
   EXPECT_TRUE(s["d0"][0]["rtd_ks_distance"].is_null());
   EXPECT_EQ(s["d0"][2]["rtd_ks_distance"].get<double>(), 0.0);
   EXPECT_NEAR(s["d0"][2]["holdup_relative_error"].get<double>(), 0.0, 1e-12);

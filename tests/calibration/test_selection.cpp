@@ -9,22 +9,27 @@ using namespace rcfd::analysis;
 
 namespace {
 
-D0Scores score(double d0, double penalty, double fieldRms, double rtdMean, std::optional<double> ks) {
+/// Scores of one run: penalty, instantaneous RMS over its counting floor, mean stay, KS distance and
+/// the mean stay's and crossing rate's relative errors against the reference.
+D0Scores score(double d0, double penalty, double rmsOverFloor, double rtdMean, std::optional<double> ks,
+               double meanError = 0.0, double rateError = 0.0) {
   D0Scores s;
   s.d0 = d0;
   s.penalty = penalty;
-  s.fieldRms = fieldRms;
+  s.countingFloorRms = 0.05;
+  s.instantaneousRms = rmsOverFloor * 0.05;
   s.rtdMean = rtdMean;
   s.stays = 100;
   s.ksDistance = ks;
+  if (ks) s.rtdMeanRelativeError = meanError, s.crossingRateRelativeError = rateError;
   return s;
 }
 
 /// The paper's pattern: penalty minimum at 1e-4, bed shape and RTD agreeing from 5e-4 on.
 std::vector<D0Scores> paperLike() {
-  return {score(0.0, 0.020, 0.20, 0.05, 0.60), score(1e-5, 0.012, 0.12, 0.08, 0.40),
-          score(1e-4, 0.006, 0.07, 0.10, 0.20), score(5e-4, 0.007, 0.042, 0.11, 0.08),
-          score(1e-3, 0.008, 0.040, 0.11, 0.07), score(1e-2, 0.010, 0.045, 0.11, 0.09)};
+  return {score(0.0, 0.020, 3.0, 0.05, 0.60, -0.5, 0.4), score(1e-5, 0.012, 2.0, 0.08, 0.40, -0.3, 0.3),
+          score(1e-4, 0.006, 1.5, 0.10, 0.20, -0.1, 0.1), score(5e-4, 0.007, 1.2, 0.11, 0.08, 0.02, -0.03),
+          score(1e-3, 0.008, 1.1, 0.11, 0.07, 0.01, -0.02), score(1e-2, 0.010, 1.15, 0.11, 0.09, 0.03, 0.05)};
 }
 
 }  // namespace
@@ -51,19 +56,38 @@ TEST(Selection, OrderOfTheListDoesNotMatter) {
 TEST(Selection, ThresholdsMoveTheChoice) {
   const auto s = paperLike();
   SelectionOptions wide;
-  wide.fieldRmsTolerance = 1.0;  // 1e-4's 0.07 <= 2 x 0.04 now counts as the right shape...
-  wide.ksThreshold = 0.25;       // ...and its KS 0.2 as agreeing residence times
+  wide.fieldRmsTolerance = 0.55;     // 1e-4's 1.5 x the floor now counts as the right shape...
+  wide.ksThreshold = 0.25;           // ...its KS 0.2 as agreeing residence times...
+  wide.rtdRelativeTolerance = 0.15;  // ...and its 10 % errors of the mean and the crossing rate
   EXPECT_EQ(s[selectD0(s, wide, true).selected].d0, 1e-4);
   SelectionOptions strict;
   strict.ksThreshold = 0.075;  // only 1e-3 passes
   EXPECT_EQ(s[selectD0(s, strict, true).selected].d0, 1e-3);
+  auto rate = s;
+  rate[3].crossingRateRelativeError = -0.12;  // 5e-4 crosses 12 % too rarely
+  EXPECT_EQ(rate[selectD0(rate, SelectionOptions{}, true).selected].d0, 1e-3);
+}
+
+TEST(Selection, AnOptimumAtTheUpperEndIsFlagged) {
+  auto s = paperLike();
+  EXPECT_FALSE(selectD0(s, SelectionOptions{}, true).atUpperEnd);
+  for (auto& x : s) x.ksDistance = 0.3;  // no RTD agrees: 1e-2 is the lowest passing bed shape? no: 5e-4
+  EXPECT_FALSE(selectD0(s, SelectionOptions{}, true).atUpperEnd);
+  auto falling = paperLike();
+  falling[5].penalty = 0.001;  // the penalty falls to the last value
+  EXPECT_TRUE(selectD0(falling, SelectionOptions{}, true).atUpperEnd);
+  auto onlyTop = paperLike();
+  for (std::size_t i = 0; i + 1 < onlyTop.size(); ++i) onlyTop[i].instantaneousRms = 0.1;  // 2 x the floor
+  const Selection sel = selectD0(onlyTop, SelectionOptions{}, true);
+  EXPECT_EQ(onlyTop[sel.selected].d0, 1e-2);
+  EXPECT_TRUE(sel.atUpperEnd);
 }
 
 TEST(Selection, WithoutReferenceUsesTheMeanResidenceTime) {
   auto s = paperLike();
-  for (auto& x : s) x.ksDistance.reset();
+  for (auto& x : s) x.ksDistance.reset(), x.rtdMeanRelativeError.reset(), x.crossingRateRelativeError.reset();
   const Selection sel = selectD0(s, SelectionOptions{}, false);
-  // Best shape is 1e-3 (mean 0.11 s); 5e-4 is within 10 % of it and of the best field RMS.
+  // Best shape is 1e-3 (mean 0.11 s); 5e-4 is within 10 % of it and its RMS within 1.25 x the floor.
   EXPECT_EQ(s[sel.selected].d0, 5e-4);
   EXPECT_NE(sel.reason.find("no reference"), std::string::npos) << sel.reason;
 }
@@ -88,12 +112,21 @@ TEST(Selection, RunWithoutStaysHasNoAgreeingResidenceTimes) {
 TEST(Selection, OptionsFromTheJobDocument) {
   const auto defaults = selectionOptionsFrom(nlohmann::json::object());
   EXPECT_EQ(defaults.fieldRmsTolerance, 0.25);
-  EXPECT_EQ(defaults.ksThreshold, 0.15);
+  EXPECT_EQ(defaults.ksThreshold, 0.10);
+  EXPECT_TRUE(defaults.extendSweep);
+  EXPECT_EQ(defaults.sweepFactor, 3.0);
   EXPECT_EQ(defaults.rtdRelativeTolerance, 0.10);
   const auto o = selectionOptionsFrom({{"calibration", {{"ks_threshold", 0.3}, {"field_rms_tolerance", 0.5}}}});
   EXPECT_EQ(o.ksThreshold, 0.3);
   EXPECT_EQ(o.fieldRmsTolerance, 0.5);
   EXPECT_EQ(o.rtdRelativeTolerance, 0.10);
+  EXPECT_FALSE(selectionOptionsFrom({{"calibration", {{"extend_sweep", false}}}}).extendSweep);
+  try {
+    selectionOptionsFrom({{"calibration", {{"sweep_factor", 1.0}}}});
+    FAIL() << "accepted sweep_factor 1";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations()[0].pointer, "/calibration/sweep_factor");
+  }
   try {
     selectionOptionsFrom({{"calibration", {{"ks_threshold", 1.5}}}});
     FAIL() << "accepted ks_threshold 1.5";

@@ -77,6 +77,34 @@ TEST(VolumeMapping, SmoothInsideACellAndExactForAParcelOnACentre) {
   EXPECT_NEAR(b.w[0], 0.49, 1e-12);
 }
 
+TEST(VolumeMapping, TheVelocitySpreadSplitsTheMeanIntoItsUpAndDownParts) {
+  SliceMapping m;
+  test::scatterParcels(m.dem, m.apparatus, 3000, m.dem.material().particle_radius, 11, 0.3);
+  DemParticles& p = m.dem.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {  // up at 2 m/s or down at 0.5 m/s, with a lateral part
+    p.v[i] = Eigen::Vector3d(0.1 * std::sin(double(i)), i % 3 == 0 ? 2.0 : -0.5, 0.0);
+  }
+  std::vector<KernelWeights> w;
+  m.mapping.weightsOf(p, w);
+  const auto spread = m.mapping.velocitySpread(p, w);
+  const auto mean = m.mapping.meanVelocity(p, w);
+  std::size_t mixed = 0;
+  for (std::size_t c = 0; c < mean.size(); ++c) {
+    EXPECT_EQ(spread.mean[c], mean[c]);
+    const double f = spread.upFraction[c];
+    ASSERT_GE(f, 0.0);
+    ASSERT_LE(f, 1.0);
+    const Eigen::Vector3d recombined = f * spread.up[c] + (1.0 - f) * spread.down[c];
+    EXPECT_NEAR((recombined - mean[c]).norm(), 0.0, 1e-12) << c;
+    if (f > 0.0) EXPECT_NEAR(spread.up[c].y(), 2.0, 1e-12);
+    if (f < 1.0 && mean[c] != Eigen::Vector3d::Zero()) EXPECT_NEAR(spread.down[c].y(), -0.5, 1e-12);
+    // Two velocities in shares f and 1 - f: the variance along y is f (1 - f) 2.5^2.
+    EXPECT_NEAR(spread.variance[c].y(), f * (1.0 - f) * 6.25, 1e-9) << c;
+    mixed += f > 0.0 && f < 1.0;
+  }
+  EXPECT_GT(mixed, 100u);
+}
+
 TEST(VolumeMapping, OverPackedCellsGiveTheirExcessToNeighboursConservatively) {
   SliceMapping m;
   std::vector<double> volume(std::size_t(m.grid.cellCount()), 0.0);

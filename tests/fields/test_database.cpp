@@ -354,3 +354,98 @@ TEST(FieldDatabase, CompressedDatabaseReadsBackEqual) {
   auto a = FieldDatabase::open(plain), b = FieldDatabase::open(packed);
   for (int n = 0; n < 5; ++n) expectFramesEqual(*a->frame(n), *b->frame(n));
 }
+
+namespace {
+/// A wavy frame with a velocity spread: shares in [0, 1], variances >= 0, all varying by cell and frame.
+void spreadFrame(const CartesianGrid& g, int n, FieldFrame& f) {
+  wavyFrame(g, n, f);
+  const std::size_t cells = std::size_t(g.cellCount());
+  f.up_fraction.resize(cells);
+  f.u_p_up.resize(3 * cells), f.u_p_down.resize(3 * cells), f.u_p_variance.resize(3 * cells);
+  for (std::size_t c = 0; c < cells; ++c) {
+    f.up_fraction[c] = float(0.5 + 0.4 * std::sin(double(c) + n));
+    for (std::size_t d = 0; d < 3; ++d) {
+      f.u_p_up[3 * c + d] = float(1.0 + 0.1 * double(c + d) + n);
+      f.u_p_down[3 * c + d] = float(-1.0 - 0.05 * double(c) - n);
+      f.u_p_variance[3 * c + d] = float(0.01 * double(c + d + std::size_t(n)));
+    }
+  }
+}
+}  // namespace
+
+TEST(FieldDatabase, TheVelocitySpreadIsReadOnlyWhenAskedFor) {
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  const std::string path = tempPath("spread.h5");
+  FieldDatabaseWriterOptions options;
+  options.velocitySpread = true;
+  writeAnalyticDatabase(path, g, variedFluid(g), 0.005, 5, [&](int n, double, FieldFrame& f) { spreadFrame(g, n, f); },
+                        "{}", options);
+  for (const std::int64_t cache : {std::int64_t(0), std::int64_t(1) << 20}) {
+    auto with = FieldDatabase::open(path, FrameStorage{cache, true});
+    auto without = FieldDatabase::open(path, FrameStorage{cache, false});
+    EXPECT_TRUE(with->hasVelocitySpread());
+    EXPECT_FALSE(without->hasVelocitySpread());
+    EXPECT_EQ(with->frameBytes(), g.cellCount() * 17 * 4);
+    EXPECT_EQ(without->frameBytes(), g.cellCount() * 7 * 4);
+    for (int n = 0; n < 5; ++n) {
+      FieldFrame expected = makeFrame(g);
+      spreadFrame(g, n, expected);
+      const auto a = with->frame(n);
+      expectFramesEqual(*a, expected);
+      EXPECT_EQ(a->up_fraction, expected.up_fraction);
+      EXPECT_EQ(a->u_p_up, expected.u_p_up);
+      EXPECT_EQ(a->u_p_down, expected.u_p_down);
+      EXPECT_EQ(a->u_p_variance, expected.u_p_variance);
+      EXPECT_FALSE(without->frame(n)->hasVelocitySpread());
+    }
+  }
+  // A database without it, asked for it: the missing dataset is named.
+  const std::string plain = writeWavyDatabase("nospread.h5", g, 3);
+  try {
+    FieldDatabase::open(plain, FrameStorage{0, true});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations().size(), 4u);
+    EXPECT_EQ(e.violations()[0].pointer, "/frames/up_fraction");
+  }
+  // Reopened for appending, the writer goes on with the spread and keeps the frames' datasets aligned.
+  {
+    auto w = FieldDatabaseWriter::reopen(path, g, 3);
+    EXPECT_TRUE(w->writesVelocitySpread());
+    FieldFrame f = makeFrame(g);
+    spreadFrame(g, 9, f);
+    w->append(f);
+    FieldFrame bare = makeFrame(g);
+    wavyFrame(g, 9, bare);
+    EXPECT_THROW(w->append(bare), InputError);  // a frame without the spread in a database with it
+    w->close();
+  }
+  auto db = FieldDatabase::open(path, FrameStorage{0, true});
+  ASSERT_EQ(db->frameCount(), 4);
+  FieldFrame expected = makeFrame(g);
+  spreadFrame(g, 9, expected);
+  EXPECT_EQ(db->frame(3)->u_p_down, expected.u_p_down);
+}
+
+TEST(FieldDatabase, AVelocitySpreadOutOfRangeIsRefusedNamingTheDataset) {
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  std::vector<FieldFrame> frames;
+  for (int n = 0; n < 3; ++n) {
+    frames.push_back(makeFrame(g));
+    spreadFrame(g, n, frames.back());
+  }
+  frames[1].up_fraction[5] = 1.5f;
+  frames[2].u_p_variance[4] = -0.1f;
+  try {
+    makeInMemoryDatabase(g, variedFluid(g), 0.005, frames);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations()[0].pointer, "/frames/up_fraction");
+    EXPECT_NE(std::string(e.what()).find("[0, 1]"), std::string::npos) << e.what();
+  }
+  frames[1].up_fraction[5] = 0.5f;
+  EXPECT_THROW(makeInMemoryDatabase(g, variedFluid(g), 0.005, frames), InputError);
+  frames[2].u_p_variance[4] = 0.1f;
+  frames[2].u_p_up.clear();  // part of the spread missing
+  EXPECT_THROW(makeInMemoryDatabase(g, variedFluid(g), 0.005, frames), InputError);
+}

@@ -78,14 +78,15 @@ TEST(Cli, ListEffectsPrintsTheVocabulary) {
   if (!haveBinary()) GTEST_SKIP() << "rcfd-solve not built";
   const Outcome o = run("list-effects");
   EXPECT_EQ(o.exitCode, 0);
-  for (const char* name : {"gas", "transport", "fluctuation", "free_flight", "deposition", "coverage", "deposition_maps"}) {
+  for (const char* name : {"gas", "transport", "fluctuation", "free_flight", "velocity_streams", "deposition", "coverage",
+                           "deposition_maps"}) {
     EXPECT_NE(o.out.find(std::string("\n  ") + name + " "), std::string::npos) << name;
   }
   EXPECT_NE(o.out.find("spray.deposition_model: exponential | linear_clipped"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("rcfd.fluctuation_model: lichtenegger_pirker | cfdem"), std::string::npos) << o.out;
   const Outcome j = run("list-effects --json");
   const auto list = nlohmann::json::parse(j.out);
-  ASSERT_EQ(list["effects"].size(), 16u);
+  ASSERT_EQ(list["effects"].size(), 17u);
   EXPECT_EQ(list["effects"][0]["name"], "gas");
   EXPECT_EQ(list["effects"][0]["stage"], "cfd_dem");
   bool apparatus = false;

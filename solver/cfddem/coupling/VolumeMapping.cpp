@@ -177,4 +177,41 @@ std::vector<Eigen::Vector3d> VolumeMapping::meanVelocity(const DemParticles& p,
   return mom;
 }
 
+VolumeMapping::VelocitySpread VolumeMapping::velocitySpread(const DemParticles& p,
+                                                           const std::vector<KernelWeights>& w) const {
+  const std::size_t cells = phi_.size();
+  VelocitySpread s;
+  s.mean = meanVelocity(p, w);
+  s.up.assign(cells, Eigen::Vector3d::Zero());
+  s.down.assign(cells, Eigen::Vector3d::Zero());
+  s.variance.assign(cells, Eigen::Vector3d::Zero());
+  s.upFraction.assign(cells, 0.0);
+  std::vector<double> volume(cells, 0.0), upVolume(cells, 0.0), downVolume(cells, 0.0);
+  // Serial scatter in index order, as meanVelocity(): deterministic sums. The variance is summed about
+  // the known mean (no cancellation of two large sums).
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double v = parcelVolume(p, i);
+    const bool up = p.v[i].y() > 0.0;
+    for (int k = 0; k < w[i].count; ++k) {
+      const std::size_t c = std::size_t(w[i].cell[std::size_t(k)]);
+      const double wv = w[i].w[std::size_t(k)] * v;
+      volume[c] += wv;
+      (up ? s.up[c] : s.down[c]) += wv * p.v[i];
+      (up ? upVolume[c] : downVolume[c]) += wv;
+      s.variance[c] += wv * (p.v[i] - s.mean[c]).cwiseAbs2();
+    }
+  }
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (!(volume[c] > 0.0)) {
+      s.up[c] = s.down[c] = s.variance[c] = Eigen::Vector3d::Zero();
+      continue;
+    }
+    s.upFraction[c] = std::clamp(upVolume[c] / volume[c], 0.0, 1.0);
+    s.up[c] = upVolume[c] > 0.0 ? Eigen::Vector3d(s.up[c] / upVolume[c]) : s.mean[c];
+    s.down[c] = downVolume[c] > 0.0 ? Eigen::Vector3d(s.down[c] / downVolume[c]) : s.mean[c];
+    s.variance[c] /= volume[c];
+  }
+  return s;
+}
+
 }  // namespace rcfd::coupling

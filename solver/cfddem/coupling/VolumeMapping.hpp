@@ -62,6 +62,17 @@ class VolumeMapping {
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> meanVelocity(const DemParticles& p, const std::vector<KernelWeights>& w) const;
 
+  /// What the mean velocity of a cell's particle volume leaves out, with the weights of meanVelocity():
+  /// the share of the volume moving up (v_y > 0), the mean velocity of the upward and of the other
+  /// volume (the cell's mean where a part holds no volume, zero in an empty cell), and the variance of
+  /// each velocity component about the mean. upFraction u_up + (1 - upFraction) u_down = mean to
+  /// round-off.
+  struct VelocitySpread {
+    std::vector<Eigen::Vector3d> mean, up, down, variance;
+    std::vector<double> upFraction;
+  };
+  VelocitySpread velocitySpread(const DemParticles& p, const std::vector<KernelWeights>& w) const;
+
   /// Interpolates a cell field to a point with weights w.
   template <class T>
   static T interpolate(const std::vector<T>& field, const KernelWeights& w) {
