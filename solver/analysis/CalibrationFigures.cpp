@@ -157,7 +157,7 @@ std::string rtdFigure(const CalibrationFigureData& d, const std::string& dir) {
   }
   if (!d.referenceRtdDensity.empty()) steps(d.referenceRtdDensity, "#000", 2.0);
   svg.textPx(60, 16, "Spray-zone residence-time distributions (Fig. 11)" +
-                         std::string(d.referenceRtdDensity.empty() ? "; no reference" : "; black: CFD-DEM"), 13);
+                         std::string(d.referenceRtdDensity.empty() ? "; no reference" : "; black: CFD-DEM on the tracers' step lattice"), 13);
   const std::string name = "calibration_rtd.svg";
   svg.save(dir + "/" + name);
   return name;

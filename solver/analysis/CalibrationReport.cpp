@@ -187,7 +187,10 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
   fig.y1 = grid.origin.y() + grid.spacing.y() * grid.shape[1];
   fig.recurrenceMidplane = runs[0].recurrenceMidplane;  // one path for all runs: the same average
   if (refHoldup) fig.referenceHoldup = in.reference.holdup, fig.referenceHoldupDt = in.reference.holdupDt;
-  if (refRtd) fig.referenceRtdDensity = densityHistogram(in.reference.durations, {}, edges);
+  if (refRtd) {  // on the tracers' step lattice, as the scores compare it (StayComparison.hpp)
+    const WeightedSample lattice = onStepLattice(in.reference.durations, dt);
+    fig.referenceRtdDensity = densityHistogram(lattice.values, lattice.weights, edges);
+  }
   fig.rtdEdges = edges;
 
   h5::File out(resultPath, h5::File::Mode::Create);

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The three regimes of the built-in CFD-DEM against their own reference (docs/calibration.md,
+# "Three regimes"): for each of quick (a spout), quick-draft-plates and quick-dilute-jet, the database
+# job, then a calibration with Eq. (9) alone ("mean") and one with the two-stream model
+# ("streams"), and a table of what each selects and how its spray-zone stays compare.
+#   bash scripts/regimes.sh OUT_DIR [REGIME ...]
+# Resumable: run it again with the same OUT_DIR and finished jobs are kept, interrupted ones resume
+# from their checkpoints. RCFD_REGIMES_DATABASE_JOB picks the database job variant (default
+# "database"; "database-10s" samples 10 s + 10 s where examples/jobs has it). Needs a build and jq.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ $# -lt 1 ]; then
+  echo "usage: $0 OUT_DIR [REGIME ...]" >&2
+  exit 2
+fi
+out=$(mkdir -p "$1" && cd "$1" && pwd)
+shift
+regimes=("$@")
+[ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-dilute-jet)
+variant=${RCFD_REGIMES_DATABASE_JOB:-database}
+solve=$(pwd)/build/rcfd-solve
+command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
+
+for r in "${regimes[@]}"; do
+  job=$(pwd)/examples/jobs/$r-$variant.json
+  [ -f "$job" ] || job=$(pwd)/examples/jobs/$r-database.json
+  if [ ! -f "$out/db-$r/summary.json" ]; then
+    echo "== $r: database job $(basename "$job") (log $out/db-$r.log)"
+    "$solve" run "$job" --out "$out/db-$r" > "$out/db-$r.log" 2>&1
+  fi
+  scene=$(pwd)/examples/$r.json
+  for model in mean streams; do
+    if [ "$model" = streams ]; then
+      patch=$(jq '{effects: (.effects | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}' "$scene")
+    else
+      patch='{}'
+    fi
+    jq -n --arg scene "$scene" --arg db "$out/db-$r/database.h5" --argjson patch "$patch" \
+      '{kind: "calibration", scene_file: $scene, scene_patch: $patch, database: $db, duration: 10.0,
+        discard: 2.0, seed: 1, checkpoint_interval: 5.0}' > "$out/cal-$r-$model.json"
+    if [ ! -f "$out/cal-$r-$model/summary.json" ]; then
+      echo "== $r: calibration, $model (log $out/cal-$r-$model.log)"
+      "$solve" run "$out/cal-$r-$model.json" --out "$out/cal-$r-$model" > "$out/cal-$r-$model.log" 2>&1
+    fi
+  done
+done
+
+# One row per regime and model, at the selected D0: the acceptance figures of the residence-time issue.
+printf '%-20s %-8s %-9s %-9s %-8s %-8s %-8s %-7s %s\n' regime model D0 RMS/floor holdup mean_stay crossing KS rule
+for r in "${regimes[@]}"; do
+  for model in mean streams; do
+    s=$out/cal-$r-$model/summary.json
+    [ -f "$s" ] || continue
+    jq -r --arg r "$r" --arg m "$model" '
+      .selected_d0 as $d | (.d0[] | select(.value == $d)) as $x |
+      def pct: if . == null then "n/a" else (. * 1000 | round / 10 | tostring) + "%" end;
+      [$r, $m, ($d | tostring), ($x.rms_over_floor * 100 | round / 100 | tostring),
+       ($x.holdup_relative_error | pct), ($x.residence_time_mean_relative_error | pct),
+       ($x.crossing_rate_relative_error | pct), ($x.rtd_ks_distance * 1000 | round / 1000 | tostring),
+       (if .selection.rule_satisfied then "met" else "not met" end)] | @tsv' "$s" |
+      awk -F'\t' '{printf "%-20s %-8s %-9s %-9s %-8s %-8s %-8s %-7s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9}'
+  done
+done
