@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The three regimes of the built-in CFD-DEM against their own reference (docs/calibration.md,
-# "Three regimes"): for each of quick (a spout), quick-draft-plates and quick-dilute-jet, the database
+# The regimes of the built-in CFD-DEM against their own reference (docs/calibration.md,
+# "Regimes"): for each of quick (a spout), quick-draft-plates, quick-dilute-jet and quick-coarse-cells
+# (the spout on cells of 3.7 parcel diameters, several parcels per cell), the database
 # job, then a calibration with Eq. (9) alone ("mean") and one with the two-stream model
 # ("streams"), and a table of what each selects and how its spray-zone stays compare.
 #   bash scripts/regimes.sh OUT_DIR [REGIME ...]
@@ -16,7 +17,7 @@ fi
 out=$(mkdir -p "$1" && cd "$1" && pwd)
 shift
 regimes=("$@")
-[ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-dilute-jet)
+[ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-dilute-jet quick-coarse-cells)
 variant=${RCFD_REGIMES_DATABASE_JOB:-database}
 solve=$(pwd)/build/rcfd-solve
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }

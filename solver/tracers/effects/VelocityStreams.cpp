@@ -217,12 +217,14 @@ class VelocityStreamsEffect final : public TracerEffect {
             if (fluid[e] > 0.0f) {
               const double qe = flux(e, d);
               face = qc > 0.0 && qe > 0.0 ? std::min(qc, qe) : (qc < 0.0 && qe < 0.0 ? std::max(qc, qe) : 0.0);
-              a = area[d] * double(std::min(fluid[i], fluid[e]));
+              // As open as the cell itself: a cut cell's faces are not where its walls are (the kernel
+              // keeps tracers off the exact walls), and the open share of a face between cut cells
+              // stopped streams sliding along a slanted wall.
+              a = area[d] * double(fluid[i]);
             }
           }
-          // The velocity at the face: the flux through the open part of it over the stream's volume fraction.
-          const double openShare = a / (area[d] * double(std::max(fluid[i], 1e-12f)));
-          f[2 * d + side] = float(face * std::min(1.0, openShare) / volumeFraction);
+          // The velocity at the face: the flux over the stream's volume fraction.
+          f[2 * d + side] = float(face / volumeFraction);
           outflow += (side == 0 ? -1.0 : 1.0) * face * a;
         }
       }
