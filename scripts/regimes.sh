@@ -23,13 +23,17 @@ solve=$(pwd)/build/rcfd-solve
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 
 for r in "${regimes[@]}"; do
-  job=$(pwd)/examples/jobs/$r-$variant.json
-  [ -f "$job" ] || job=$(pwd)/examples/jobs/$r-database.json
-  if [ ! -f "$out/db-$r/summary.json" ]; then
-    echo "== $r: database job $(basename "$job") (log $out/db-$r.log)"
-    "$solve" run "$job" --out "$out/db-$r" > "$out/db-$r.log" 2>&1
-  fi
+  example=$(pwd)/examples/jobs/$r-$variant.json
+  [ -f "$example" ] || example=$(pwd)/examples/jobs/$r-database.json
   scene=$(pwd)/examples/$r.json
+  # The example's database job, with velocity_streams among the scene's effects: the database then
+  # carries the velocity spread the streams model reads (the mean model ignores it).
+  jq --arg scene "$scene" --argjson effects "$(jq '.effects + ["velocity_streams"]' "$scene")" \
+    '.scene_file = $scene | .scene_patch = ((.scene_patch // {}) + {effects: $effects})' "$example" > "$out/db-$r.json"
+  if [ ! -f "$out/db-$r/summary.json" ]; then
+    echo "== $r: database job $(basename "$example") with the velocity spread (log $out/db-$r.log)"
+    "$solve" run "$out/db-$r.json" --out "$out/db-$r" > "$out/db-$r.log" 2>&1
+  fi
   for model in mean streams; do
     if [ "$model" = streams ]; then
       patch=$(jq '{effects: (.effects | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}' "$scene")

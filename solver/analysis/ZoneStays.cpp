@@ -9,6 +9,7 @@ namespace rcfd {
 nlohmann::json StayStatistics::toJson() const {
   return {{"mean_s", mean_s},
           {"median_s", median_s},
+          {"p90_s", p90_s},
           {"stays", stays},
           {"censored", censored},
           {"histogram", {{"edges", edges}, {"counts", counts}}}};
@@ -40,11 +41,13 @@ StayStatistics ZoneStays::statistics(double dt, int bins) const {
     s.stays += durationCounts_[d];
     sumSteps += std::int64_t(d) * durationCounts_[d];
   }
-  // Median from the integer histogram.
-  for (std::int64_t d = 0, seen = 0; d < std::int64_t(durationCounts_.size()); ++d) {
+  // Median and p90 from the integer histogram (the lower quantiles, as StayComparison's).
+  bool medianFound = false;
+  for (std::int64_t d = 0, seen = 0; d < std::int64_t(durationCounts_.size()) && s.stays > 0; ++d) {
     seen += durationCounts_[std::size_t(d)];
-    if (2 * seen >= s.stays && s.stays > 0) {
-      s.median_s = double(d) * dt;
+    if (!medianFound && 2 * seen >= s.stays) s.median_s = double(d) * dt, medianFound = true;
+    if (10 * seen >= 9 * s.stays) {
+      s.p90_s = double(d) * dt;
       break;
     }
   }

@@ -27,10 +27,11 @@ struct StayStatistics {
   std::int64_t censored = 0;   ///< stays still open at the end
   double mean_s = 0.0;         ///< mean duration [s] (0 without stays)
   double median_s = 0.0;       ///< median duration [s] (0 without stays)
+  double p90_s = 0.0;          ///< 90th percentile of the durations [s] (0 without stays)
   std::vector<double> edges;   ///< histogram bin edges [s], bins + 1 of them from 0
   std::vector<std::int64_t> counts;  ///< stays per bin
 
-  /// {"mean_s", "median_s", "stays", "censored", "histogram": {"edges", "counts"}} (CONTRACTS.md).
+  /// {"mean_s", "median_s", "p90_s", "stays", "censored", "histogram": {"edges", "counts"}} (CONTRACTS.md).
   nlohmann::json toJson() const;
 };
 

@@ -1,6 +1,7 @@
 // The "database" job (issue 7): the built-in CFD-DEM of the scene sampled into a recurrence field
 // database. Phases, in whole DEM steps (cfddem/DatabaseSchedule.hpp): fill and settle (DEM only), a
-// linear ramp of the gas flows, a warm-up at full flow, frames of alpha_P, u_P and u_G every dt_rec for
+// linear ramp of the gas flows, a warm-up at full flow, frames of alpha_P, u_P and u_G (and the velocity
+// spread when a tracer effect of the scene reads it) every dt_rec for
 // sample_duration (appended to DIR/database.h5 as they come), then the reference period. Throughout
 // the sampled and reference periods the reference series (probe u_P,y, pressure drop; spray-zone holdup
 // and stays in the reference period) are recorded every 1/probe_rate (cfddem/ReferenceRecorder.hpp)
@@ -26,6 +27,7 @@
 #include "jobs/Cancellation.hpp"
 #include "jobs/JobRunner.hpp"
 #include "jobs/Progress.hpp"
+#include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
 namespace {
@@ -53,14 +55,19 @@ std::vector<float> interleaved(const std::vector<Eigen::Vector3d>& values) {
   return out;
 }
 
-/// A frame of the current instant, with the velocity spread (what velocity_streams reads).
-FieldFrame sampleFrame(const CfdDemSimulation& sim) {
+/// A frame of the current instant; with the velocity spread when `withSpread` (a scene whose tracer
+/// effects read it: 17 floats per cell instead of 7, on disk and in every reader's memory).
+FieldFrame sampleFrame(const CfdDemSimulation& sim, bool withSpread) {
   FieldFrame f;
   const auto alpha = sim.particleFraction();
-  const auto spread = sim.particleVelocitySpread();
   f.alpha_p.assign(alpha.begin(), alpha.end());
-  f.u_p = interleaved(spread.mean);
   f.u_g = interleaved(sim.gasVelocity());
+  if (!withSpread) {
+    f.u_p = interleaved(sim.particleVelocity());
+    return f;
+  }
+  const auto spread = sim.particleVelocitySpread();
+  f.u_p = interleaved(spread.mean);
   f.up_fraction.assign(spread.upFraction.begin(), spread.upFraction.end());
   f.u_p_up = interleaved(spread.up);
   f.u_p_down = interleaved(spread.down);
@@ -151,7 +158,7 @@ class DatabaseJob final : public JobRunner {
       st.settledStep = sim.demStep();
       makeRecorder();
       FieldDatabaseWriterOptions writeOptions;
-      writeOptions.velocitySpread = true;
+      writeOptions.velocitySpread = TracerEffectRegistry::needsVelocitySpread(scene.effects);
       writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(), scene.source_json,
                                                      writeOptions);
       progress->report(fraction(), sim.time(), true);
@@ -169,11 +176,7 @@ class DatabaseJob final : public JobRunner {
       // Events at the current instant first: a checkpoint taken after a step resumes here.
       const std::int64_t offset = sim.demStep() - st.settledStep;
       if (st.framesWritten < plan.frames && offset == plan.frameOffset(st.framesWritten)) {
-        FieldFrame frame = sampleFrame(sim);
-        if (!writer->writesVelocitySpread()) {  // a database begun by a version without it: keep it uniform
-          for (const auto& f : kVelocitySpreadFields) (frame.*f.member).clear();
-        }
-        writer->append(frame);
+        writer->append(sampleFrame(sim, writer->writesVelocitySpread()));
         ++st.framesWritten;
       }
       if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {

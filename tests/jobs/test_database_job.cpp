@@ -224,6 +224,35 @@ TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
   EXPECT_TRUE(fs::exists(dir_ / "figs" / "database_alpha_p.svg"));
 }
 
+TEST_F(DatabaseJob, TheVelocitySpreadIsWrittenWhenATracerEffectReadsItAndAddsUpToTheMean) {
+  json scene = sceneDocument();
+  scene["effects"] = json::array({"rolling_friction", "transport", "tracer_volume_fraction", "velocity_streams"});
+  writeJob(scene, "streams.json");
+  ASSERT_EQ(solve(run("s", "", "streams.json")).exitCode, 0);
+  ASSERT_EQ(solve(run("plain")).exitCode, 0);
+  // Without the effect, the database is as before: no spread datasets, and the same frames.
+  rcfd::h5::File plain((dir_ / "plain" / "database.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+  for (const auto& f : rcfd::kVelocitySpreadFields) EXPECT_FALSE(plain.exists(f.path)) << f.path;
+  expectSameDatabase(dir_ / "s" / "database.h5", dir_ / "plain" / "database.h5");
+  auto db = rcfd::FieldDatabase::open((dir_ / "s" / "database.h5").string(), rcfd::FrameStorage{0, true});
+  ASSERT_TRUE(db->hasVelocitySpread());
+  long moving = 0;
+  for (int n = 0; n < db->frameCount(); ++n) {
+    const auto f = db->frame(n);
+    for (std::size_t c = 0; c < f->alpha_p.size(); ++c) {
+      const double share = f->up_fraction[c];
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double recombined = share * f->u_p_up[3 * c + d] + (1.0 - share) * f->u_p_down[3 * c + d];
+        EXPECT_NEAR(recombined, f->u_p[3 * c + d], 1e-5 + 1e-5 * std::abs(f->u_p[3 * c + d])) << "frame " << n;
+        EXPECT_GE(f->u_p_variance[3 * c + d], 0.0f);
+      }
+      if (f->alpha_p[c] == 0.0f) EXPECT_EQ(share, 0.0);
+      moving += f->u_p_variance[3 * c + 1] > 0.0f;
+    }
+  }
+  EXPECT_GT(moving, 0);  // the settled bed still jiggles
+}
+
 TEST_F(DatabaseJob, StoppedAndResumedEqualsUninterrupted) {
   ASSERT_EQ(solve(run("a")).exitCode, 0);
   // Stop during sampling, then again later; resume the second time from the FIRST checkpoint, as if

@@ -86,6 +86,10 @@ class ResidenceTimeEffect final : public TracerEffect {
     out.setAttribute("/holdup/particles", "dt", dt);
     out.setAttribute("/holdup/particles", "t0", double(ctx.discardSteps) * dt);
     summary["residence_time"] = st.toJson();
+    // Stays per tracer per second of the collected time: per particle too, as a tracer's particles
+    // move with it (the calibration's crossing rate, analysis/StayComparison.hpp).
+    const double collected = double(holdup_.size()) * dt * double(ctx.cloud.size());
+    summary["residence_time"]["crossings_per_tracer_per_s"] = collected > 0.0 ? double(st.stays) / collected : 0.0;
     summary["holdup"] = {{"mean", holdupMean * ctx.cloud.particlesPerTracer},
                          {"mean_fraction", ctx.cloud.size() ? holdupMean / double(ctx.cloud.size()) : 0.0},
                          {"series_file", "result.h5:/holdup/particles"}};
