@@ -19,10 +19,10 @@
 // flux, and with it alpha_P^rec, is that of Eq. (9) alone. A tracer keeps its stream as long as the
 // fluxes and shares allow, which is what lets it cross the spray zone as fast as the particles do.
 //
-// What it needs: per-frame shares that mean something, i.e. many parcels per cell. Measured on the
-// built-in quick slice (about one parcel per spray-zone cell, docs/calibration.md) the per-frame
-// shares are mostly 0 or 1 and the model over-packs the bed; on analytic databases it reproduces the
-// particles' stays (tests/tracers/test_velocity_streams.cpp).
+// What it needs: per-frame shares that mean something, i.e. several particles per cell. On analytic
+// databases it reproduces the particles' stays (tests/tracers/test_velocity_streams.cpp); on the
+// built-in quick slices, about one parcel per spray-zone cell, it is about as close as Eq. (9) alone
+// (docs/calibration.md, "Regimes").
 //
 // Blended between the step's frames. Random numbers from the tracer's counter-based stream (purpose
 // Streams): bit-identical for any thread count and across a checkpoint. Tracers in free flight keep
