@@ -97,14 +97,12 @@ class VelocityStreamsEffect final : public TracerEffect {
         // the counting noise of its n tracers (sigma = sqrt(f (1 - f) / n); the noise itself would only
         // turn tracers round at random): an up tracer leaves with probability (g - f - sigma) / g, a
         // down tracer with (f - g - sigma) / (1 - g).
-        const double n = double(std::max<std::int32_t>(1, count[c]));
-        const double g = double(upCount_[c]) / n;
-        const double sigma = std::sqrt(f * (1.0 - f) / n);
+        const double here = double(std::max<std::int32_t>(1, count[c]));
+        const double g = double(upCount_[c]) / here;
+        const double sigma = std::sqrt(f * (1.0 - f) / here);
         if (s && g - f > sigma && u * g < g - f - sigma) s = 0, ++switches;
         else if (!s && f - g > sigma && u * (1.0 - g) < f - g - sigma) s = 1, ++switches;
       }
-      // The stream's velocity at the midpoint it predicts (the kernel's rule), less u_P^rec there: the
-      // kernel adds this to u_P^rec at its own midpoint, near this one.
       // What the stream does over the step, less what u_P^rec does: the kernel samples u_P^rec where
       // the stream's path has its midpoint (or at the start, with Euler), near where it is sampled here.
       const Eigen::Vector3d p = ctx.cloud.position(std::size_t(i));
