@@ -59,11 +59,6 @@ std::vector<float> slice(const std::vector<float>& field, const CartesianGrid& g
 
 nlohmann::json optionalNumber(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 
-/// Real particles of the bed: bed mass over the mass of one particle.
-double realParticles(const Scene& scene) {
-  const auto& p = scene.particles;
-  return scene.process.bed_mass / (p.density * 3.14159265358979323846 / 6.0 * p.diameter * p.diameter * p.diameter);
-}
 
 }  // namespace
 
@@ -108,7 +103,8 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
   const double refHoldupMean = in.reference.holdupMean();
   // The members whose stays the reference counted: its own attribute, else the scene's real particles
   // (one member each, as the tracers' holdup is counted).
-  const double refMembers = in.reference.members > 0.0 ? in.reference.members : realParticles(in.scene);
+  const double refMembers = referenceMembers(in.reference, in.scene.process.bed_mass, in.scene.particles.density,
+                                            in.scene.particles.diameter);
   const double tracerPeriod = double(in.steps - in.discardSteps) * dt;
 
   std::vector<D0Scores> scores(n);

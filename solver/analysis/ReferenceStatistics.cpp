@@ -28,6 +28,13 @@ double ReferenceStatistics::holdupMean() const {
   return holdup.empty() ? 0.0 : sum / double(holdup.size());
 }
 
+double referenceMembers(const ReferenceStatistics& reference, double bedMass, double particleDensity,
+                        double particleDiameter) {
+  if (reference.members > 0.0) return reference.members;
+  const double particleMass = particleDensity * 3.14159265358979323846 / 6.0 * std::pow(particleDiameter, 3);
+  return bedMass / particleMass;
+}
+
 ReferenceStatistics readReferenceStatistics(const std::string& path) {
   namespace L = reference_layout;
   ReferenceStatistics r;

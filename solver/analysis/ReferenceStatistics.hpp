@@ -35,6 +35,11 @@ struct ReferenceStatistics {
   double recordedPeriod() const { return period > 0.0 ? period : double(holdup.size()) * holdupDt; }
 };
 
+/// The members whose stays the reference counted: its own attribute, else the real particles of the
+/// scene's bed (bed mass over the mass of one particle), as the tracers' holdup is counted.
+double referenceMembers(const ReferenceStatistics& reference, double bedMass, double particleDensity,
+                        double particleDiameter);
+
 /// Reads the reference statistics of a database file. Absent datasets go into `missing`; present but
 /// malformed ones (non-finite or negative values, empty, missing or non-positive dt) are an
 /// rcfd::InputError naming the file and dataset.

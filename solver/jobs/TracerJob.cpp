@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <spdlog/spdlog.h>
 
+#include "analysis/ReferenceStatistics.hpp"
+#include "analysis/StayComparison.hpp"
 #include "core/Errors.hpp"
 #include "jobs/Cancellation.hpp"
 #include "jobs/JobRunner.hpp"
@@ -14,6 +16,28 @@
 
 namespace rcfd {
 namespace {
+
+/// The run's spray-zone stays against the full simulation's reference in the database, on the tracers'
+/// step lattice (analysis/StayComparison.hpp); null without residence_time or without a reference.
+nlohmann::json stayComparison(const JobSpec& job, const Scene& scene, const std::string& resultPath,
+                              std::int64_t steps) {
+  analysis::ReferenceStatistics reference;
+  try {
+    reference = analysis::readReferenceStatistics(job.database);
+  } catch (const InputError& e) {  // a damaged reference must not cost the finished run its summary
+    spdlog::warn("no stay comparison: {}", e.what());
+    return {{"error", e.what()}};
+  }
+  h5::File result(resultPath, h5::File::Mode::ReadOnly);
+  const char* counts = "/residence_time/duration_steps_counts";
+  if (!reference.hasDurations() || !result.exists(counts)) return nullptr;
+  const double members = analysis::referenceMembers(reference, scene.process.bed_mass, scene.particles.density,
+                                                    scene.particles.diameter);
+  return analysis::compareStays(result.readInt64s(counts), scene.rcfd.dt, double(scene.rcfd.tracers),
+                                double(steps) * scene.rcfd.dt, reference.durations, members,
+                                reference.recordedPeriod())
+      .toJson();
+}
 
 class TracerJob final : public JobRunner {
  public:
@@ -80,6 +104,7 @@ class TracerJob final : public JobRunner {
       out.flush();
     }
     std::filesystem::rename(options.outDir + "/result.h5.tmp", options.outDir + "/result.h5");
+    summary["stay_comparison"] = stayComparison(job, scene, options.outDir + "/result.h5", steps);
     if (scene.outputs.svg) summary["figures"] = sim.writeFigures(options.outDir);
     summary["path"] = {{"jumps", rec.pathStats.jumps},
                        {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},

@@ -116,6 +116,32 @@ TEST_F(SprayJob, RunsAndReportsProgressAndTheContractKeys) {
   EXPECT_FALSE(fs::exists(dir_ / "a" / "checkpoint.h5"));
 }
 
+TEST_F(SprayJob, ComparesItsStaysWithTheDatabasesReferenceWhenThereIsOne) {
+  ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "plain").string()).exitCode, 0);
+  EXPECT_TRUE(json::parse(std::ifstream(dir_ / "plain" / "summary.json"))["stay_comparison"].is_null());
+  {  // 300 reference stays of 0.02 s (4 steps exactly), of 100 parcels over 1 s
+    rcfd::h5::File db((dir_ / "db.h5").string(), rcfd::h5::File::Mode::ReadWrite);
+    db.write("/reference/residence_time/durations_s", std::vector<double>(300, 0.02));
+    db.setAttribute("/reference/residence_time/durations_s", "dt", 0.001);
+    db.setAttribute("/reference/residence_time/durations_s", "members", 100.0);
+    db.setAttribute("/reference/residence_time/durations_s", "period_s", 1.0);
+  }
+  ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "ref").string()).exitCode, 0);
+  const json s = json::parse(std::ifstream(dir_ / "ref" / "summary.json"));
+  const json& c = s["stay_comparison"];
+  ASSERT_TRUE(c.is_object()) << s.dump(1);
+  EXPECT_DOUBLE_EQ(c["lattice_dt_s"].get<double>(), 0.005);
+  EXPECT_NEAR(c["reference"]["mean_s"].get<double>(), 0.02, 1e-12);
+  EXPECT_NEAR(c["reference"]["crossings_per_member_per_s"].get<double>(), 3.0, 1e-9);
+  EXPECT_EQ(c["reference_unseen_fraction"].get<double>(), 0.0);
+  EXPECT_EQ(c["tracers"]["stays"].get<double>(), s["residence_time"]["stays"].get<double>());
+  EXPECT_NEAR(c["tracers"]["mean_s"].get<double>(), s["residence_time"]["mean_s"].get<double>(), 1e-12);
+  EXPECT_NEAR(c["tracers"]["crossings_per_member_per_s"].get<double>(),
+              s["residence_time"]["crossings_per_tracer_per_s"].get<double>(), 1e-12);
+  EXPECT_GE(c["ks_distance"].get<double>(), 0.0);
+  EXPECT_LE(c["ks_distance"].get<double>(), 1.0);
+}
+
 TEST_F(SprayJob, InterruptedAndResumedEqualsUninterrupted) {
   ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "a").string()).exitCode, 0);
   const SolveResult stopped =
