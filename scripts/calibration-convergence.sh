@@ -23,7 +23,7 @@ command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq
 
 # One tracer per real particle: bed mass over the mass of one particle.
 particles=$(jq '.process.bed_mass / (.particles.density * 3.141592653589793 / 6 * pow(.particles.diameter; 3)) | round' "$scene")
-printf '%-9s %-5s %-10s %-10s %-9s %-8s %-8s %-8s %-7s %s\n' tracers seed selected penalty_min RMS/floor holdup mean_stay crossing KS rule
+printf '%-9s %-5s %-10s %-11s %-9s %-8s %-8s %-8s %-7s %s\n' tracers seed selected penalty_min RMS/floor holdup mean_stay crossing KS rule
 for count in "${counts[@]}"; do
   n=$count
   [ "$count" = one-per-particle ] && n=$particles
@@ -34,13 +34,7 @@ for count in "${counts[@]}"; do
         duration: 10.0, discard: 2.0, seed: $seed, checkpoint_interval: 5.0,
         d0_values: [0, 1e-5, 1e-4, 5e-4, 1e-3, 1e-2, 3e-2, 1e-1]}' > "$dir.json"
     [ -f "$dir/summary.json" ] || "$solve" run "$dir.json" --out "$dir" > "$dir.log" 2>&1
-    jq -r --arg n "$n" --arg seed "$seed" '
-      .selected_d0 as $d | (.d0[] | select(.value == $d)) as $x |
-      def pct: if . == null then "n/a" else (. * 1000 | round / 10 | tostring) + "%" end;
-      [$n, $seed, ($d | tostring), (.penalty_minimum_d0 | tostring), ($x.rms_over_floor * 100 | round / 100 | tostring),
-       ($x.holdup_relative_error | pct), ($x.residence_time_mean_relative_error | pct),
-       ($x.crossing_rate_relative_error | pct), ($x.rtd_ks_distance * 1000 | round / 1000 | tostring),
-       (if .selection.rule_satisfied then "met" else "not met" end)] | @tsv' "$dir/summary.json" |
-      awk -F'\t' '{printf "%-9s %-5s %-10s %-10s %-9s %-8s %-8s %-8s %-7s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10}'
+    printf '%s\t%s\t%s\n' "$n" "$seed" "$(jq -r -f scripts/calibration-scores.jq "$dir/summary.json")" |
+      awk -F'\t' '{printf "%-9s %-5s %-10s %-11s %-9s %-8s %-8s %-8s %-7s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10}'
   done
 done

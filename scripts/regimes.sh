@@ -51,18 +51,12 @@ for r in "${regimes[@]}"; do
 done
 
 # One row per regime and model, at the selected D0: the acceptance figures of the residence-time issue.
-printf '%-20s %-8s %-9s %-9s %-8s %-8s %-8s %-7s %s\n' regime model D0 RMS/floor holdup mean_stay crossing KS rule
+printf '%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %s\n' regime model D0 penalty_min RMS/floor holdup mean_stay crossing KS rule
 for r in "${regimes[@]}"; do
   for model in mean streams; do
     s=$out/cal-$r-$model/summary.json
     [ -f "$s" ] || continue
-    jq -r --arg r "$r" --arg m "$model" '
-      .selected_d0 as $d | (.d0[] | select(.value == $d)) as $x |
-      def pct: if . == null then "n/a" else (. * 1000 | round / 10 | tostring) + "%" end;
-      [$r, $m, ($d | tostring), ($x.rms_over_floor * 100 | round / 100 | tostring),
-       ($x.holdup_relative_error | pct), ($x.residence_time_mean_relative_error | pct),
-       ($x.crossing_rate_relative_error | pct), ($x.rtd_ks_distance * 1000 | round / 1000 | tostring),
-       (if .selection.rule_satisfied then "met" else "not met" end)] | @tsv' "$s" |
-      awk -F'\t' '{printf "%-20s %-8s %-9s %-9s %-8s %-8s %-8s %-7s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9}'
+    printf '%s\t%s\t%s\n' "$r" "$model" "$(jq -r -f scripts/calibration-scores.jq "$s")" |
+      awk -F'\t' '{printf "%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10}'
   done
 done
