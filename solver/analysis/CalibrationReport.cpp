@@ -11,6 +11,7 @@
 #include "analysis/StayComparison.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
+#include "geometry/SprayZone.hpp"
 
 namespace rcfd::analysis {
 namespace {
@@ -59,6 +60,33 @@ std::vector<float> slice(const std::vector<float>& field, const CartesianGrid& g
 
 nlohmann::json optionalNumber(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 
+
+/// Particles the recurrence field holds in the spray zone: sum over cells of alpha_P x open volume x the
+/// share of the cell inside the zone (4 x 4 x 4 points per cell), over the volume of one particle.
+double fieldHoldup(const Scene& scene, const CartesianGrid& grid, const std::vector<float>& alpha,
+                   const std::vector<float>& fluid) {
+  const SprayZone zone(scene.spray.spray_zone);
+  const auto& p = scene.particles;
+  const double particleVolume = 3.14159265358979323846 / 6.0 * p.diameter * p.diameter * p.diameter;
+  constexpr int kPoints = 4;
+  double volume = 0.0;
+  for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+    if (!(alpha[std::size_t(c)] > 0.0f)) continue;
+    const auto ijk = grid.cellIjk(c);
+    int inside = 0;
+    for (int a = 0; a < kPoints; ++a)
+      for (int b = 0; b < kPoints; ++b)
+        for (int d = 0; d < kPoints; ++d) {
+          const Eigen::Vector3d q = grid.origin + grid.spacing.cwiseProduct(Eigen::Vector3d(
+                                                      ijk[0] + (a + 0.5) / kPoints, ijk[1] + (b + 0.5) / kPoints,
+                                                      ijk[2] + (d + 0.5) / kPoints));
+          inside += zone.contains(q);
+        }
+    const double share = double(inside) / (kPoints * kPoints * kPoints);
+    volume += double(alpha[std::size_t(c)]) * grid.cellVolume() * double(fluid[std::size_t(c)]) * share;
+  }
+  return volume / particleVolume;
+}
 
 }  // namespace
 
@@ -305,6 +333,15 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
         summariseStays(onStepLattice(in.reference.durations, dt), refMembers, in.reference.recordedPeriod()).mean_s;
   }
   if (refHoldup) reference["holdup_mean"] = refHoldupMean;
+  // What the recurrence field itself holds in the zone over the runs' collected steps (one path for all
+  // runs: the same average), beside the parcel centres the reference counts (docs/calibration.md).
+  {
+    h5::File r(in.runsDir + "/d0_0/result.h5", h5::File::Mode::ReadOnly);
+    const double field = fieldHoldup(in.scene, grid, r.readFloats("/field_average/alpha_p_recurrence"),
+                                     in.database.fluidFraction());
+    reference["recurrence_field_holdup"] = field;
+    if (refHoldup && refHoldupMean > 0.0) reference["recurrence_field_holdup_over_reference"] = field / refHoldupMean;
+  }
 
   nlohmann::json summary = {{"d0", list},
                             {"selected_d0", scores[sel.selected].d0},
