@@ -207,6 +207,16 @@ TEST(CalibrationJob, MissingReferenceIsReportedNotFatal) {
     EXPECT_TRUE(d["holdup_relative_error"].is_null());
   }
   EXPECT_EQ(s["selection"]["residence_times_judged_by"], "mean_relative_tolerance");
+  // The field's own holdup is reported without a reference too. After frame 0 the field is 0.25
+  // everywhere, and the zone is a vertical cylinder of radius 10 m x tan(0.03 deg) = 5.24 mm about
+  // z = 5 mm, 20 mm high, cut by the walls z = 0 and 10 mm: 85.3 mm2 x 20 mm.
+  const JobSpec job = makeJob(scratch("noref-geometry"));
+  const double r = 10.0 * std::tan(0.03 * 3.14159265358979323846 / 180.0), d = 0.005;
+  const double cap = r * r * std::acos(d / r) - d * std::sqrt(r * r - d * d);
+  const double zoneVolume = (3.14159265358979323846 * r * r - 2.0 * cap) * 0.02;
+  const double particle = 3.14159265358979323846 / 6.0 * std::pow(job.scene.particles.diameter, 3);
+  EXPECT_NEAR(ref["recurrence_field_holdup"].get<double>(), 0.25 * zoneVolume / particle, 0.05 * 0.25 * zoneVolume / particle);
+  EXPECT_FALSE(ref.contains("recurrence_field_holdup_over_reference"));
 }
 
 TEST(CalibrationJob, ReferenceStatisticsAreUsed) {
