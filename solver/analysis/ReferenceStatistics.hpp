@@ -17,6 +17,16 @@ inline constexpr const char* holdupDt = "dt";                                   
 /// of the period they were recorded over [s] (crossing rates).
 inline constexpr const char* members = "members";
 inline constexpr const char* period = "period_s";
+/// Optional: the coverage the scene's spray model gives on the full simulation's own parcels over its
+/// reference period (spray/ReferenceCoverage.hpp): droplets per real particle, per parcel id, with the
+/// attributes below; and the spray's books [injected, deposited, airborne, overspray at walls, overspray
+/// at the outlet, residual] in droplets.
+inline constexpr const char* coverageDroplets = "/reference/coverage/droplets_per_particle";  ///< float64 [N]
+inline constexpr const char* coverageBalance = "/reference/coverage/balance_droplets";       ///< float64 [6]
+inline constexpr const char* coverageDuration = "duration_s";                  ///< length of the spray [s]
+inline constexpr const char* coverageDt = "dt";                                ///< its step [s]
+inline constexpr const char* coverageParticlesPerParcel = "particles_per_parcel";  ///< cg^3 [-]
+inline constexpr const char* coverageSingleDroplet = "f";  ///< Eq. (15)'s f of the scene [-]
 }  // namespace reference_layout
 
 struct ReferenceStatistics {

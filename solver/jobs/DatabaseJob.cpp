@@ -5,7 +5,9 @@
 // sample_duration (appended to DIR/database.h5 as they come), then the reference period. Throughout
 // the sampled and reference periods the reference series (probe u_P,y, pressure drop; spray-zone holdup
 // and stays in the reference period) are recorded every 1/probe_rate (cfddem/ReferenceRecorder.hpp)
-// and written under /reference/ at the end. A scene without the effect `gas` runs the DEM only.
+// and written under /reference/ at the end; a scene that asks for the coverage also gets the coverage
+// its spray model gives on the parcels themselves over the reference period
+// (spray/ReferenceCoverage.hpp). A scene without the effect `gas` runs the DEM only.
 //
 // Checkpoints (DIR/checkpoint.h5, every checkpoint_interval and on cancellation) hold the simulation
 // state and the job's counters; a resumed job cuts database.h5 back to the frames sampled before the
@@ -27,12 +29,16 @@
 #include "jobs/Cancellation.hpp"
 #include "jobs/JobRunner.hpp"
 #include "jobs/Progress.hpp"
+#include "spray/ReferenceCoverage.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// Checkpoint group of the reference coverage's state.
+constexpr const char* kCoverageGroup = "/reference_coverage";
 
 /// Frame cache when the figures read the database back: a few frames of the largest grids.
 constexpr std::int64_t kFigureCacheBytes = 256LL << 20;
@@ -107,10 +113,15 @@ class DatabaseJob final : public JobRunner {
 
     JobState st;
     std::unique_ptr<ReferenceRecorder> rec;
+    std::unique_ptr<ReferenceCoverage> coverage;
     std::unique_ptr<FieldDatabaseWriter> writer;
     auto makeRecorder = [&] {
       rec = std::make_unique<ReferenceRecorder>(scene, sim.grid(), sim.dem().particles().size(), plan.sampleDt(),
                                                 plan.sampledSamples());
+      if (ReferenceCoverage::wanted(scene) && sim.hasGas() && plan.referenceSamples > 0) {
+        coverage = std::make_unique<ReferenceCoverage>(scene, sim.apparatus(), sim.grid(), open,
+                                                       sim.dem().particles().size(), plan.sampleDt(), job.seed);
+      }
     };
     if (fs::exists(checkpoint)) {
       loadCheckpoint(checkpoint, job, sim, st);
@@ -118,6 +129,7 @@ class DatabaseJob final : public JobRunner {
         makeRecorder();
         h5::File f(checkpoint, h5::File::Mode::ReadOnly);
         rec->load(f, "/reference");
+        if (coverage && f.exists(kCoverageGroup + std::string("/step"))) coverage->load(f, kCoverageGroup);
       }
       spdlog::info("resumed from {} at t = {:.4f} s, {} frames kept", checkpoint, sim.time(), st.framesWritten);
     }
@@ -142,7 +154,7 @@ class DatabaseJob final : public JobRunner {
     auto save = [&] {
       JobState now = st;
       now.wallTime = st.wallTime + elapsed();
-      saveCheckpoint(checkpoint, job, sim, now, rec.get());
+      saveCheckpoint(checkpoint, job, sim, now, rec.get(), coverage.get());
     };
     auto cancelled = [&](const std::string& where) {
       save();
@@ -180,6 +192,10 @@ class DatabaseJob final : public JobRunner {
         ++st.framesWritten;
       }
       if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {
+        // The reference coverage steps from every sample of the reference period to the next.
+        if (coverage && rec->samples() >= plan.sampledSamples()) {
+          coverage->step(sim.dem().particles(), std::make_shared<const FieldFrame>(sampleFrame(sim, false)));
+        }
         rec->record(sim.particleVelocity(), sim.pressureDrop(), sim.dem().particles());
         const DemParticles& p = sim.dem().particles();
         st.reachedTop.resize(p.size(), 0);
@@ -212,6 +228,7 @@ class DatabaseJob final : public JobRunner {
     {
       h5::File db(databasePath, h5::File::Mode::ReadWrite);
       rec->write(db);
+      if (coverage) coverage->write(db);
       db.flush();
     }
     progress->report(1.0, sim.time(), true);
@@ -241,6 +258,7 @@ class DatabaseJob final : public JobRunner {
                          {"reference_s", double(plan.referenceSamples) * plan.sampleDt()},
                          {"sampling_start_s", double(st.settledStep + plan.frameOffset(0)) * plan.dtDem}};
     summary.update(rec->summary(plan.dtRec(), scene.outputs.residence_time_bins));
+    summary["reference_coverage"] = coverage ? coverage->summary() : nlohmann::json();
     // Blow-out: the DEM keeps parcels in with a wall at the outlet, so report how close they came. A
     // parcel that reached the top between two samples (1 / probe_rate apart) would have had to cover
     // the gap in that time.
@@ -263,7 +281,7 @@ class DatabaseJob final : public JobRunner {
 
  private:
   static void saveCheckpoint(const std::string& path, const JobSpec& job, const CfdDemSimulation& sim,
-                             const JobState& st, const ReferenceRecorder* rec) {
+                             const JobState& st, const ReferenceRecorder* rec, const ReferenceCoverage* coverage) {
     const std::string tmp = path + ".tmp";
     {
       h5::File f(tmp, h5::File::Mode::Create);
@@ -278,6 +296,7 @@ class DatabaseJob final : public JobRunner {
       f.write("/job/reached_top", st.reachedTop);
       sim.saveState(f, "/simulation");
       if (rec) rec->save(f, "/reference");
+      if (coverage) coverage->save(f, kCoverageGroup);
       f.flush();
     }
     fs::rename(tmp, path);

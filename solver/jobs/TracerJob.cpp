@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <spdlog/spdlog.h>
 
+#include "analysis/CoverageComparison.hpp"
 #include "analysis/ReferenceStatistics.hpp"
 #include "analysis/StayComparison.hpp"
 #include "core/Errors.hpp"
@@ -12,6 +13,7 @@
 #include "jobs/JobRunner.hpp"
 #include "jobs/Progress.hpp"
 #include "jobs/RecurrenceSetup.hpp"
+#include "spray/Coverage.hpp"
 #include "tracers/TracerSimulation.hpp"
 
 namespace rcfd {
@@ -37,6 +39,25 @@ nlohmann::json stayComparison(const JobSpec& job, const Scene& scene, const std:
                                 double(steps) * scene.rcfd.dt, reference.durations, members,
                                 reference.recordedPeriod())
       .toJson();
+}
+
+/// The run's coverage distribution against the full simulation's over the same duration
+/// (analysis/CoverageComparison.hpp); null without coverage or without a reference coverage.
+nlohmann::json coverageComparison(const JobSpec& job, const Scene& scene, const std::string& resultPath,
+                                  double particlesPerTracer, double duration) {
+  const char* droplets = "/coverage/droplets_per_particle";
+  try {
+    const auto reference = analysis::readReferenceCoverage(job.database);
+    h5::File result(resultPath, h5::File::Mode::ReadOnly);
+    if (!reference || !result.exists(droplets)) return nullptr;
+    const double f = singleDropletCoverage(scene.spray.droplet_diameter, scene.particles.diameter);
+    return analysis::compareCoverage(result.readDoubles(droplets), particlesPerTracer, duration, scene.rcfd.dt, f,
+                                     *reference)
+        .toJson();
+  } catch (const InputError& e) {  // a damaged or foreign reference must not cost the finished run its summary
+    spdlog::warn("no coverage comparison: {}", e.what());
+    return {{"error", e.what()}};
+  }
 }
 
 class TracerJob final : public JobRunner {
@@ -105,6 +126,8 @@ class TracerJob final : public JobRunner {
     }
     std::filesystem::rename(options.outDir + "/result.h5.tmp", options.outDir + "/result.h5");
     summary["stay_comparison"] = stayComparison(job, scene, options.outDir + "/result.h5", steps);
+    summary["coverage_comparison"] = coverageComparison(job, scene, options.outDir + "/result.h5",
+                                                        sim.cloud().particlesPerTracer, sim.time());
     if (scene.outputs.svg) summary["figures"] = sim.writeFigures(options.outDir);
     summary["path"] = {{"jumps", rec.pathStats.jumps},
                        {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},

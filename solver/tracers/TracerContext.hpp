@@ -25,9 +25,15 @@ inline constexpr std::int64_t kParallelThreshold = 4096;
 struct SprayState;  // solver/spray/SprayState.hpp: parcels, balances, droplets per tracer
 
 struct TracerContext {
+  TracerContext(const Scene& scene, const Apparatus& apparatus, const FieldDatabase* database,
+                const CartesianGrid& grid, TracerCloud& cloud, std::uint64_t seed)
+      : scene(scene), apparatus(apparatus), database(database), grid(grid), cloud(cloud), seed(seed) {}
+
   const Scene& scene;
   const Apparatus& apparatus;
-  const FieldDatabase& database;
+  /// The database the frames come from; null when the stages run on frames from elsewhere (the
+  /// database job's reference coverage runs the spray effects on the CFD-DEM's own fields).
+  const FieldDatabase* database;
   const CartesianGrid& grid;
   TracerCloud& cloud;
   std::uint64_t seed = 1;

@@ -49,8 +49,8 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   const double realParticles = scene_.process.bed_mass / (p.density * cloud_.particleVolume);
   cloud_.particlesPerTracer = realParticles / double(scene_.rcfd.tracers);
 
-  context_ = std::make_unique<TracerContext>(
-      TracerContext{scene_, *apparatus_, *database_, database_->grid(), cloud_, settings_.seed});
+  context_ = std::make_unique<TracerContext>(scene_, *apparatus_, database_.get(), database_->grid(), cloud_,
+                                             settings_.seed);
   auto& ctx = *context_;
   ctx.dt = scene_.rcfd.dt;
   ctx.totalSteps = settings_.steps;

@@ -156,6 +156,7 @@ TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
   for (const char* key : {"mean_pa", "std_pa", "dominant_frequency_hz"}) EXPECT_TRUE(s["pressure_drop"].contains(key));
   EXPECT_DOUBLE_EQ(s["pressure_drop"]["mean_pa"].get<double>(), 0.0);  // no gas
   EXPECT_TRUE(s["pressure_drop"]["dominant_frequency_hz"].is_null());
+  EXPECT_TRUE(s["reference_coverage"].is_null());  // the scene asks for no coverage
   for (const char* key : {"mean_s", "median_s", "histogram"}) EXPECT_TRUE(s["residence_time"].contains(key));
   EXPECT_TRUE(s["holdup"].contains("mean"));
   // Blow-out: a settled DEM-only bed of 340 parcels in a 0.1 m box stays at the bottom: its highest
@@ -246,7 +247,9 @@ TEST_F(DatabaseJob, TheVelocitySpreadIsWrittenWhenATracerEffectReadsItAndAddsUpT
         EXPECT_NEAR(recombined, f->u_p[3 * c + d], 1e-5 + 1e-5 * std::abs(f->u_p[3 * c + d])) << "frame " << n;
         EXPECT_GE(f->u_p_variance[3 * c + d], 0.0f);
       }
-      if (f->alpha_p[c] == 0.0f) EXPECT_EQ(share, 0.0);
+      if (f->alpha_p[c] == 0.0f) {
+        EXPECT_EQ(share, 0.0);
+      }
       moving += f->u_p_variance[3 * c + 1] > 0.0f;
     }
   }
@@ -313,6 +316,52 @@ TEST_F(DatabaseJob, GasJobStoppedAndResumedEqualsUninterrupted) {
   float largest = 0.0f;
   for (const float v : db->frame(2)->u_g) largest = std::max(largest, std::abs(v));
   EXPECT_GT(largest, 0.1f);
+}
+
+// A scene that asks for the coverage gets the full simulation's own: the spray model on the parcels over
+// the reference period, one value per parcel, books that close, stepped at the reference samples.
+TEST_F(DatabaseJob, RecordsTheReferenceCoverageWhenTheSceneAsksForTheCoverage) {
+  json scene = json::parse(R"({
+    "name": "database-coverage-test",
+    "apparatus": {"type": "prismatic_spouted_bed", "width": 0.06, "depth": 0.01, "height": 0.3,
+                  "prism_angle_deg": 60, "inlet_width": 0.01},
+    "grid": {"cell_size": 0.005},
+    "gas": {"max_time_step": 5e-5},
+    "particles": {},
+    "process": {"gas_flow_rate": 2e-4, "atomisation_flow_rate": 1e-6, "bed_mass": 6.4e-4},
+    "spray": {"nozzle_position": [0.0, 0.0, 0.005], "nozzle_diameter": 0.002, "parcels_per_s": 20000,
+              "spray_zone": {"apex": [0.0, 0.0, 0.005], "half_angle_deg": 30, "y_min": 0.005, "y_max": 0.04}},
+    "dem": {"time_step": 1e-5, "coupling_interval": 5, "settle_time": 0.05, "ramp_time": 0.01, "warmup": 0.01,
+            "sample_rate": 200, "probe_rate": 1000, "sample_duration": 0.015, "reference_duration": 0.02},
+    "probes": [{"name": "spout", "position": [0.0, 0.02, 0.005]}],
+    "effects": ["gas", "drag", "smoothing", "rolling_friction", "tracer_volume_fraction", "spray", "deposition",
+                "coverage"],
+    "outputs": {"svg": false}
+  })");
+  writeJob(scene, "coverage.json");
+  ASSERT_EQ(solve(run("a", "", "coverage.json")).exitCode, 0);
+  const json s = summaryOf(dir_ / "a");
+  const json& c = s["reference_coverage"];
+  ASSERT_TRUE(c.is_object()) << s.dump(1);
+  EXPECT_NEAR(c["duration_s"].get<double>(), 0.02, 1e-12);
+  EXPECT_NEAR(c["dt_s"].get<double>(), 0.001, 1e-15);
+  EXPECT_EQ(c["parcels"], s["particles"]);
+  EXPECT_DOUBLE_EQ(c["particles_per_parcel"].get<double>(), s["particles_per_parcel"].get<double>());
+  EXPECT_GT(c["deposited_fraction"].get<double>(), 0.0);
+  rcfd::h5::File db((dir_ / "a" / "database.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+  const auto droplets = db.readDoubles(rcfd::analysis::reference_layout::coverageDroplets);
+  EXPECT_EQ(droplets.size(), s["particles"].get<std::size_t>());
+  double collected = 0.0;
+  for (const double n : droplets) {
+    EXPECT_GE(n, 0.0);
+    collected += n * s["particles_per_parcel"].get<double>();
+  }
+  const auto books = db.readDoubles(rcfd::analysis::reference_layout::coverageBalance);
+  ASSERT_EQ(books.size(), 6u);
+  EXPECT_NEAR(books[0], books[1] + books[2] + books[3] + books[4] + books[5], 1e-9 * books[0]);
+  // Whole droplets on the parcels; what is deposited but not handed out waits in cells (< 1 each).
+  EXPECT_LE(collected, books[1] + 1e-9);
+  EXPECT_GT(collected, 0.0);
 }
 
 TEST_F(DatabaseJob, BadInputsExitTwoNamingTheField) {

@@ -2,6 +2,7 @@
 // SIGTERM-style interruption (exit 130 with a checkpoint) and resume equal to an uninterrupted run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -140,6 +141,63 @@ TEST_F(SprayJob, ComparesItsStaysWithTheDatabasesReferenceWhenThereIsOne) {
               s["residence_time"]["crossings_per_tracer_per_s"].get<double>(), 1e-12);
   EXPECT_GE(c["ks_distance"].get<double>(), 0.0);
   EXPECT_LE(c["ks_distance"].get<double>(), 1.0);
+}
+
+TEST_F(SprayJob, ComparesItsCoverageWithTheDatabasesReferenceCoverage) {
+  ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "plain").string()).exitCode, 0);
+  EXPECT_TRUE(json::parse(std::ifstream(dir_ / "plain" / "summary.json"))["coverage_comparison"].is_null());
+  // The run's own droplets per particle as the reference over its duration: distance 0, errors 0. Then
+  // every reference particle far more coated.
+  const json plain = json::parse(std::ifstream(dir_ / "plain" / "summary.json"));
+  std::vector<double> droplets;
+  {
+    rcfd::h5::File result((dir_ / "plain" / "result.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+    droplets = result.readDoubles("/coverage/droplets_per_particle");
+  }
+  const double singleDrop = plain["coverage"]["f"].get<double>();
+  // A copy of the database with the given reference coverage, and a job on it.
+  auto jobWithReference = [&](const std::string& name, const std::vector<double>& values, double duration) {
+    const fs::path db = dir_ / (name + ".h5");
+    fs::copy_file(dir_ / "db.h5", db, fs::copy_options::overwrite_existing);
+    {
+      rcfd::h5::File f(db.string(), rcfd::h5::File::Mode::ReadWrite);
+      const char* set = "/reference/coverage/droplets_per_particle";
+      f.write(set, values);
+      f.setAttribute(set, "duration_s", duration);
+      f.setAttribute(set, "dt", 0.001);
+      f.setAttribute(set, "particles_per_parcel", plain["particles_per_tracer"].get<double>());
+      f.setAttribute(set, "f", singleDrop);
+    }
+    json job = json::parse(std::ifstream(dir_ / "job.json"));
+    job["database"] = db.string();
+    const fs::path path = dir_ / (name + ".json");
+    std::ofstream(path) << job.dump(2);
+    return path.string();
+  };
+  auto comparisonOf = [&](const std::string& name, const std::vector<double>& values, double duration) {
+    const std::string job = jobWithReference(name, values, duration);
+    EXPECT_EQ(solve("run " + job + " --out " + (dir_ / name).string()).exitCode, 0);
+    return json::parse(std::ifstream(dir_ / name / "summary.json"))["coverage_comparison"];
+  };
+  const json same = comparisonOf("same", droplets, 0.4);
+  ASSERT_TRUE(same.is_object());
+  EXPECT_TRUE(same["same_duration"].get<bool>());
+  EXPECT_EQ(same["ks_distance"].get<double>(), 0.0);
+  EXPECT_EQ(same["mean_relative_error"].get<double>(), 0.0);
+  EXPECT_FALSE(same.contains("note")) << same.dump(1);
+  // Every reference particle above the run's most coated one: the distributions do not overlap (KS 1).
+  const double top = *std::max_element(droplets.begin(), droplets.end()) + 1.0;
+  std::vector<double> above = droplets;
+  double mean = 0.0;
+  for (double& v : above) mean += v, v += top;
+  mean /= double(droplets.size());
+  const json less = comparisonOf("above", above, 0.4);
+  EXPECT_EQ(less["ks_distance"].get<double>(), 1.0);
+  EXPECT_NEAR(less["droplets_per_particle_relative_error"].get<double>(), mean / (mean + top) - 1.0, 1e-9);
+  // Another duration: reported, not compared.
+  const json other = comparisonOf("other", droplets, 2.0);
+  EXPECT_FALSE(other["same_duration"].get<bool>());
+  EXPECT_FALSE(other.contains("ks_distance"));
 }
 
 TEST_F(SprayJob, InterruptedAndResumedEqualsUninterrupted) {

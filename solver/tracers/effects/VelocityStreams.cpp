@@ -43,8 +43,8 @@ namespace {
 class VelocityStreamsEffect final : public TracerEffect {
  public:
   explicit VelocityStreamsEffect(TracerContext& ctx) {
-    if (!ctx.database.hasVelocitySpread()) {
-      throw InputError(ctx.database.path(), kVelocitySpreadFields[0].path,
+    if (!ctx.database || !ctx.database->hasVelocitySpread()) {
+      throw InputError(ctx.database ? ctx.database->path() : "(no database)", kVelocitySpreadFields[0].path,
                        "the effect velocity_streams needs the velocity spread of the frames; this database has "
                        "none (the database job writes it)");
     }
@@ -186,7 +186,7 @@ class VelocityStreamsEffect final : public TracerEffect {
     const std::int64_t cells = grid.cellCount();
     out.resize(std::size_t(cells));
     faces.resize(6 * std::size_t(cells));
-    const auto& fluid = ctx.database.fluidFraction();
+    const auto& fluid = ctx.database->fluidFraction();
     auto shareOf = [&](std::size_t c) { return up ? double(upShare_[c]) : 1.0 - double(upShare_[c]); };
     auto flux = [&](std::size_t c, int d) { return double(alpha_[c]) * shareOf(c) * double(stream[3 * c + std::size_t(d)]); };
     const double area[3] = {grid.spacing.y() * grid.spacing.z(), grid.spacing.x() * grid.spacing.z(),
