@@ -3,7 +3,9 @@
 # "Regimes"): for each of quick (a spout), quick-draft-plates, quick-dilute-jet and quick-coarse-cells
 # (the spout on cells of 3.7 parcel diameters, several parcels per cell), the database
 # job, then a calibration with Eq. (9) alone ("mean") and one with the two-stream model
-# ("streams"), and a table of what each selects and how its spray-zone stays compare.
+# ("streams"), a spray job of each at its selected D0 with one tracer per parcel over the reference
+# period (its coverage distribution against the full simulation's), and a table of what each selects
+# and how its spray-zone stays and coverage compare.
 #   bash scripts/regimes.sh OUT_DIR [REGIME ...]
 # Resumable: run it again with the same OUT_DIR and finished jobs are kept, interrupted ones resume
 # from their checkpoints. RCFD_REGIMES_DATABASE_JOB picks the database job variant (default
@@ -47,16 +49,35 @@ for r in "${regimes[@]}"; do
       echo "== $r: calibration, $model (log $out/cal-$r-$model.log)"
       "$solve" run "$out/cal-$r-$model.json" --out "$out/cal-$r-$model" > "$out/cal-$r-$model.log" 2>&1
     fi
+    # The coverage over the reference period, one tracer per parcel (as many particles per member as the
+    # reference), at the selected D0: needs a database that recorded the reference coverage.
+    duration=$(jq '.reference_coverage.duration_s // empty' "$out/db-$r/summary.json")
+    [ -n "$duration" ] || continue
+    jq -n --arg scene "$scene" --arg db "$out/db-$r/database.h5" --argjson patch "$patch" \
+      --argjson d0 "$(jq '.selected_d0' "$out/cal-$r-$model/summary.json")" \
+      --argjson tracers "$(jq '.particles' "$out/db-$r/summary.json")" --argjson duration "$duration" \
+      '{kind: "spray", scene_file: $scene, scene_patch: ($patch + {rcfd: {d0: $d0, tracers: $tracers}}),
+        database: $db, duration: $duration, seed: 1, checkpoint_interval: 60.0}' > "$out/spray-$r-$model.json"
+    if [ ! -f "$out/spray-$r-$model/summary.json" ]; then
+      echo "== $r: spray over the reference period, $model (log $out/spray-$r-$model.log)"
+      "$solve" run "$out/spray-$r-$model.json" --out "$out/spray-$r-$model" > "$out/spray-$r-$model.log" 2>&1
+    fi
   done
 done
 
-# One row per regime and model, at the selected D0: the acceptance figures of the residence-time issue.
-printf '%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %s\n' regime model D0 penalty_min RMS/floor holdup mean_stay crossing KS rule
+# One row per regime and model, at the selected D0: the acceptance figures of the residence-time issue
+# (coverage: KS distance and mean coverage error of the spray job against the reference coverage).
+printf '%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %-8s %-8s %s\n' regime model D0 penalty_min RMS/floor \
+  holdup mean_stay crossing KS rule cov_KS cov_mean
 for r in "${regimes[@]}"; do
   for model in mean streams; do
     s=$out/cal-$r-$model/summary.json
     [ -f "$s" ] || continue
-    printf '%s\t%s\t%s\n' "$r" "$model" "$(jq -r -f scripts/calibration-scores.jq "$s")" |
-      awk -F'\t' '{printf "%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10}'
+    c=$out/spray-$r-$model/summary.json
+    coverage="n/a	n/a"
+    [ -f "$c" ] && coverage=$(jq -r '.coverage_comparison | [(.ks_distance // "n/a" | tostring),
+      (if .mean_relative_error == null then "n/a" else (.mean_relative_error * 1000 | round / 10 | tostring) + "%" end)] | @tsv' "$c")
+    printf '%s\t%s\t%s\t%s\n' "$r" "$model" "$(jq -r -f scripts/calibration-scores.jq "$s")" "$coverage" |
+      awk -F'\t' '{printf "%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %-8s %-8s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12}'
   done
 done
