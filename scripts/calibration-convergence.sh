@@ -3,8 +3,9 @@
 # calibrations with each tracer count and seed (a seed is a path and a tracer placement), D0 swept up
 # to where u_fluc_max binds, and one row per run: selected D0, penalty minimum, and the scores there.
 #   bash scripts/calibration-convergence.sh SCENE.json DATABASE.h5 OUT_DIR [TRACERS ...]
-# TRACERS defaults to "20000 one-per-particle 100000"; RCFD_SEEDS to "1 2 3"; RCFD_MODEL=streams adds
-# velocity_streams to the scene's effects (the database must carry the velocity spread). Resumable
+# TRACERS defaults to "20000 one-per-particle 100000"; RCFD_SEEDS to "1 2 3"; RCFD_MODEL picks the tracer
+# motion model of scripts/model-effects.jq (mean, streams: the database must carry the velocity spread,
+# relax). Resumable
 # (finished calibrations are kept). Needs a build and jq.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,10 +23,10 @@ seeds=${RCFD_SEEDS:-1 2 3}
 solve=$(pwd)/build/rcfd-solve
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 
-effects='{}'
-if [ "${RCFD_MODEL:-mean}" = streams ]; then
-  effects=$(jq '{effects: (.effects | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}' "$scene")
-  out=$out/streams
+model=${RCFD_MODEL:-mean}
+effects=$(jq --arg model "$model" -f scripts/model-effects.jq "$scene")
+if [ "$model" != mean ]; then
+  out=$out/$model
   mkdir -p "$out"
 fi
 # One tracer per real particle: bed mass over the mass of one particle.

@@ -2,14 +2,16 @@
 # The regimes of the built-in CFD-DEM against their own reference (docs/calibration.md,
 # "Regimes"): for each of quick (a spout), quick-draft-plates, quick-dilute-jet and quick-coarse-cells
 # (the spout on cells of 3.7 parcel diameters, several parcels per cell), the database
-# job, then a calibration with Eq. (9) alone ("mean") and one with the two-stream model
-# ("streams"), a spray job of each at its selected D0 with one tracer per parcel over the reference
+# job, then a calibration per tracer motion model (scripts/model-effects.jq: "mean", Eq. (9) with
+# Eq. (10); "streams", the two-stream velocity; "relax", directed relaxation instead of Eq. (10)), a
+# spray job of each at its selected D0 with one tracer per parcel over the reference
 # period (its coverage distribution against the full simulation's), and a table of what each selects
 # and how its spray-zone stays and coverage compare.
 #   bash scripts/regimes.sh OUT_DIR [REGIME ...]
 # Resumable: run it again with the same OUT_DIR and finished jobs are kept, interrupted ones resume
 # from their checkpoints. RCFD_REGIMES_DATABASE_JOB picks the database job variant (default
-# "database"; "database-10s" samples 10 s + 10 s where examples/jobs has it). Needs a build and jq.
+# "database"; "database-10s" samples 10 s + 10 s where examples/jobs has it), RCFD_REGIMES_MODELS the
+# models (default "mean streams relax"). Needs a build and jq.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 1 ]; then
@@ -21,6 +23,7 @@ shift
 regimes=("$@")
 [ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-dilute-jet quick-coarse-cells)
 variant=${RCFD_REGIMES_DATABASE_JOB:-database}
+read -r -a models <<< "${RCFD_REGIMES_MODELS:-mean streams relax}"
 solve=$(pwd)/build/rcfd-solve
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 
@@ -36,12 +39,8 @@ for r in "${regimes[@]}"; do
     echo "== $r: database job $(basename "$example") with the velocity spread (log $out/db-$r.log)"
     "$solve" run "$out/db-$r.json" --out "$out/db-$r" > "$out/db-$r.log" 2>&1
   fi
-  for model in mean streams; do
-    if [ "$model" = streams ]; then
-      patch=$(jq '{effects: (.effects | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}' "$scene")
-    else
-      patch='{}'
-    fi
+  for model in "${models[@]}"; do
+    patch=$(jq --arg model "$model" -f scripts/model-effects.jq "$scene")
     jq -n --arg scene "$scene" --arg db "$out/db-$r/database.h5" --argjson patch "$patch" \
       '{kind: "calibration", scene_file: $scene, scene_patch: $patch, database: $db, duration: 10.0,
         discard: 2.0, seed: 1, checkpoint_interval: 5.0}' > "$out/cal-$r-$model.json"
@@ -70,7 +69,7 @@ done
 printf '%-20s %-8s %-9s %-11s %-9s %-8s %-8s %-8s %-7s %-8s %-8s %s\n' regime model D0 penalty_min RMS/floor \
   holdup mean_stay crossing KS rule cov_KS cov_mean
 for r in "${regimes[@]}"; do
-  for model in mean streams; do
+  for model in "${models[@]}"; do
     s=$out/cal-$r-$model/summary.json
     [ -f "$s" ] || continue
     c=$out/spray-$r-$model/summary.json
