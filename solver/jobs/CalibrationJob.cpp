@@ -37,14 +37,21 @@ namespace fs = std::filesystem;
 /// The paper's range of D0 values [m2/s], used when the job gives none.
 const std::vector<double> kDefaultD0 = {0.0, 1e-5, 1e-4, 5e-4, 1e-3, 1e-2};
 /// Effects of every calibration run, whatever the scene lists...
-const std::vector<std::string> kCalibrationEffects = {"transport", "fluctuation",   "free_flight",
-                                                      "walls",     "tracer_volume_fraction", "probes",
-                                                      "residence_time", "field_average"};
+const std::vector<std::string> kCalibrationEffects = {"transport", "free_flight", "walls", "tracer_volume_fraction",
+                                                      "probes", "residence_time", "field_average"};
+/// ...the relaxation models whose strength D0 is: those of the scene's list, Eq. (10)'s `fluctuation`
+/// when it lists none...
+const std::vector<std::string> kRelaxationModels = {"fluctuation", "directed_relaxation"};
 /// ...and the motion models of the scene's list that change how tracers move (calibrated with them).
 const std::vector<std::string> kCalibratedModels = {"velocity_streams"};
 
 std::vector<std::string> calibrationEffects(const Scene& scene) {
-  std::vector<std::string> effects = kCalibrationEffects;
+  std::vector<std::string> effects = {kCalibrationEffects.front()};
+  for (const auto& m : kRelaxationModels) {
+    if (scene.hasEffect(m)) effects.push_back(m);
+  }
+  if (effects.size() == 1) effects.push_back(kRelaxationModels.front());
+  effects.insert(effects.end(), kCalibrationEffects.begin() + 1, kCalibrationEffects.end());
   for (const auto& m : kCalibratedModels) {
     if (scene.hasEffect(m)) effects.push_back(m);
   }
