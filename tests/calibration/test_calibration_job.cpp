@@ -3,6 +3,8 @@
 // alpha_P to the recurrence alpha_P. Checks the penalty ordering, the summary, determinism, thread
 // independence, missing and present reference statistics, and resume after an interruption.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <unistd.h>
 
 #include <chrono>
@@ -193,6 +195,20 @@ TEST(CalibrationJob, RelaxationLowersThePenaltyAndEveryD0IsReported) {
   for (const auto& f : s["figures"]) EXPECT_TRUE(fs::exists(dir / "out" / f.get<std::string>())) << f;
   EXPECT_EQ(s["figures"].size(), 5u);
   EXPECT_TRUE(fs::exists(dir / "out/summary.json"));
+}
+
+// A scene that lists directed_relaxation is calibrated with it in place of Eq. (10): D0 is its
+// strength, and it relaxes the bed of the left half as Eq. (10) does.
+TEST(CalibrationJob, TheRelaxationModelTheSceneListsIsCalibrated) {
+  const fs::path dir = scratch("directed");
+  JobSpec job = makeJob(dir, {0.0, 1e-3});
+  job.scene.effects = {"transport", "directed_relaxation"};
+  job.source["extend_sweep"] = false;
+  const json s = run(job, dir / "out");
+  const auto effects = s["effects"].get<std::vector<std::string>>();
+  EXPECT_NE(std::find(effects.begin(), effects.end(), "directed_relaxation"), effects.end());
+  EXPECT_EQ(std::find(effects.begin(), effects.end(), "fluctuation"), effects.end());
+  EXPECT_GT(s["d0"][0]["field_rms_difference"].get<double>(), 2.0 * s["d0"][1]["field_rms_difference"].get<double>());
 }
 
 TEST(CalibrationJob, MissingReferenceIsReportedNotFatal) {
