@@ -5,6 +5,7 @@
 
 #include "SceneTestUtil.hpp"
 #include "core/EmbeddedFiles.hpp"
+#include "geometry/Apparatus.hpp"
 #include "scene/SceneJson.hpp"
 #include "core/Errors.hpp"
 #include "scene/SceneLoader.hpp"
@@ -91,4 +92,26 @@ TEST(Examples, JsonRoundTripReproducesTheScene) {
     const Scene b = loadScene(written);  // the written form is itself a valid scene
     EXPECT_EQ(sceneToJson(b), written);
   }
+}
+
+// The aligned draft-plates slice puts each plate across a plane of cell faces, so no cell holds open
+// volume on both sides of a plate (its particles' velocities would be averaged across it); the plain
+// slice's plates lie inside a column of cells.
+TEST(Examples, TheAlignedDraftPlatesSeparateTheCellsOnTheirTwoSides) {
+  auto sidesShareACell = [](const std::string& example) {
+    const Scene s = loadSceneFile(rcfd::test::sourcePath(example));
+    const Apparatus apparatus(s.apparatus);
+    const CartesianGrid grid = makeGrid(apparatus, s.grid);
+    const auto& plates = *s.apparatus.draft_plates;
+    const double inner = 0.5 * plates.gap, outer = inner + plates.thickness, y = plates.elevation + 0.5 * plates.height;
+    bool shared = false;
+    for (const double side : {-1.0, 1.0}) {
+      const auto in = grid.flatIndexOf(Vec3(side * (inner - 1e-6), y, 0.01));
+      const auto out = grid.flatIndexOf(Vec3(side * (outer + 1e-6), y, 0.01));
+      shared = shared || in == out;
+    }
+    return shared;
+  };
+  EXPECT_FALSE(sidesShareACell("examples/quick-draft-plates-aligned.json"));
+  EXPECT_TRUE(sidesShareACell("examples/quick-draft-plates.json"));
 }
