@@ -53,6 +53,7 @@ nlohmann::json runTracers(const Options& options) {
       {"+free_flight", {"transport", "walls", "fluctuation", "tracer_volume_fraction", "free_flight"}},
       {"+residence_time", {"transport", "walls", "fluctuation", "tracer_volume_fraction", "residence_time"}},
       {"+field_average", {"transport", "walls", "fluctuation", "tracer_volume_fraction", "field_average"}},
+      {"directed_relaxation for fluctuation", {"transport", "walls", "directed_relaxation", "tracer_volume_fraction"}},
       {"headline, euler", {"transport", "walls", "fluctuation", "tracer_volume_fraction"}},
   };
   // RCFD_BENCH_TRACERS_HEADLINE_ONLY=1: the headline configuration only (A/B comparisons of the kernel).

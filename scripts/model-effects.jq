@@ -1,11 +1,14 @@
-# The scene_patch that selects a tracer motion model on a scene (jq --arg model M -f this SCENE.json):
-#   mean     the scene as it is: Eq. (9) with Eq. (10)'s random-walk relaxation
-#   streams  velocity_streams added after transport (the two-stream velocity)
-#   relax    Eq. (10) replaced by directed_relaxation (the directed flux down the excess gradient)
+# The scene_patch that selects a tracer motion model on a scene (jq --arg model M -f this SCENE.json),
+# whichever relaxation the scene itself lists:
+#   mean     Eq. (9) with Eq. (10)'s random-walk relaxation (`fluctuation`)
+#   streams  the same with velocity_streams added after transport (the two-stream velocity)
+#   relax    Eq. (9) with directed_relaxation (the directed flux down the excess gradient)
 # Shared by scripts/regimes.sh and scripts/calibration-convergence.sh.
-if $model == "mean" then {}
+def relaxation($name): map(if . == "fluctuation" or . == "directed_relaxation" then $name else . end);
+def withoutStreams: map(select(. != "velocity_streams"));
+if $model == "mean" then {effects: (.effects | withoutStreams | relaxation("fluctuation"))}
 elif $model == "streams" then
-  {effects: (.effects | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}
-elif $model == "relax" then
-  {effects: (.effects | map(if . == "fluctuation" then "directed_relaxation" else . end))}
+  {effects: (.effects | withoutStreams | relaxation("fluctuation")
+             | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}
+elif $model == "relax" then {effects: (.effects | withoutStreams | relaxation("directed_relaxation"))}
 else error("unknown model \($model): mean, streams or relax") end
