@@ -3,7 +3,8 @@
 // directedDiffusiveRelaxation) instead of Eq. (10)'s random walk. Per step, with e = alpha_P,tracers -
 // alpha_P^rec per open cell:
 //   1. one implicit diffusion step of the excess, (I - D0 dt L) w = e (L: the 7-point Laplacian over
-//      the open cells, no flux into closed ones), solved by conjugate gradients from the last step's w;
+//      the open cells, no flux into closed ones or across a draft plate), solved by conjugate
+//      gradients from the last step's w;
 //   2. through every open face the diffusive flux of particle volume -D0 grad w, carried by the
 //      tracers of the cell it leaves: u_relax = flux / alpha_P,tracers, capped at rcfd.u_fluc_max and
 //      at half a cell per step;
@@ -57,7 +58,7 @@ class DirectedRelaxationEffect final : public TracerEffect {
     upperNeighbour_.assign(3 * open_.size(), -1);
     for (std::size_t r = 0; r < open_.size(); ++r) {
       double diagonal = 1.0;
-      forEachNeighbour(grid, open_[r], [&](int d, int side, std::int32_t other) {
+      forEachNeighbour(ctx, open_[r], [&](int d, int side, std::int32_t other) {
         entries.emplace_back(int(r), row_[std::size_t(other)], -beta[d]);
         diagonal += beta[d];
         if (side > 0) upperNeighbour_[3 * r + std::size_t(d)] = row_[std::size_t(other)];
@@ -120,9 +121,11 @@ class DirectedRelaxationEffect final : public TracerEffect {
   }
 
  private:
-  /// Calls f(dimension, side, neighbour) for each open face neighbour of cell c.
+  /// Calls f(dimension, side, neighbour) for each open neighbour of cell c that no plate separates
+  /// from it (no flux pushes tracers against a plate they cannot pass).
   template <class F>
-  void forEachNeighbour(const CartesianGrid& grid, std::int32_t c, F&& f) const {
+  void forEachNeighbour(const TracerContext& ctx, std::int32_t c, F&& f) const {
+    const CartesianGrid& grid = ctx.grid;
     const auto ijk = grid.cellIjk(c);
     for (int d = 0; d < 3; ++d) {
       for (int side : {-1, 1}) {
@@ -130,9 +133,28 @@ class DirectedRelaxationEffect final : public TracerEffect {
         nb[std::size_t(d)] += side;
         if (nb[std::size_t(d)] < 0 || nb[std::size_t(d)] >= grid.shape[std::size_t(d)]) continue;
         const auto other = std::int32_t(grid.flatIndex(nb[0], nb[1], nb[2]));
-        if (row_[std::size_t(other)] >= 0) f(d, side, other);
+        if (row_[std::size_t(other)] < 0) continue;
+        if (d < 2 && plateBetween(ctx.apparatus, grid.cellCenter(ijk[0], ijk[1], ijk[2]),
+                                  grid.cellCenter(nb[0], nb[1], nb[2]), d)) {
+          continue;
+        }
+        f(d, side, other);
       }
     }
+  }
+
+  /// Whether the segment a-b along axis d (0: x, 1: y) of the section crosses a plate (the plates are
+  /// axis-aligned rectangles extruded along z, so faces normal to z never do).
+  static bool plateBetween(const Apparatus& apparatus, const Eigen::Vector3d& a, const Eigen::Vector3d& b, int d) {
+    const int across = 1 - d;
+    for (const auto& plate : apparatus.holes()) {
+      Eigen::Vector2d lo = plate[0], hi = plate[0];
+      for (const auto& v : plate) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      const double at = a[across];
+      if (!(at > lo[across] && at < hi[across])) continue;
+      if (std::max(a[d], b[d]) > lo[d] && std::min(a[d], b[d]) < hi[d]) return true;
+    }
+    return false;
   }
 
   /// e = alpha_P of the tracers - alpha_P^rec of the step, then one implicit diffusion step of it.
