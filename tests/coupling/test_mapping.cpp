@@ -96,8 +96,12 @@ TEST(VolumeMapping, TheVelocitySpreadSplitsTheMeanIntoItsUpAndDownParts) {
     ASSERT_LE(f, 1.0);
     const Eigen::Vector3d recombined = f * spread.up[c] + (1.0 - f) * spread.down[c];
     EXPECT_NEAR((recombined - mean[c]).norm(), 0.0, 1e-12) << c;
-    if (f > 0.0) EXPECT_NEAR(spread.up[c].y(), 2.0, 1e-12);
-    if (f < 1.0 && mean[c] != Eigen::Vector3d::Zero()) EXPECT_NEAR(spread.down[c].y(), -0.5, 1e-12);
+    if (f > 0.0) {
+      EXPECT_NEAR(spread.up[c].y(), 2.0, 1e-12);
+    }
+    if (f < 1.0 && mean[c] != Eigen::Vector3d::Zero()) {
+      EXPECT_NEAR(spread.down[c].y(), -0.5, 1e-12);
+    }
     // Two velocities in shares f and 1 - f: the variance along y is f (1 - f) 2.5^2.
     EXPECT_NEAR(spread.variance[c].y(), f * (1.0 - f) * 6.25, 1e-9) << c;
     mixed += f > 0.0 && f < 1.0;
