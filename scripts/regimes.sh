@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The regimes of the built-in CFD-DEM against their own reference (docs/calibration.md,
-# "Regimes"): for each of quick (a spout), quick-draft-plates, quick-dilute-jet and quick-coarse-cells
+# "Regimes"): for each of quick (a spout), quick-draft-plates (and its plates on cell faces,
+# quick-draft-plates-aligned), quick-dilute-jet and quick-coarse-cells
 # (the spout on cells of 3.7 parcel diameters, several parcels per cell), the database
 # job, then a calibration per tracer motion model (scripts/model-effects.jq: "mean", Eq. (9) with
 # Eq. (10); "streams", the two-stream velocity; "relax", directed relaxation instead of Eq. (10)), a
@@ -21,7 +22,7 @@ fi
 out=$(mkdir -p "$1" && cd "$1" && pwd)
 shift
 regimes=("$@")
-[ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-dilute-jet quick-coarse-cells)
+[ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-draft-plates-aligned quick-dilute-jet quick-coarse-cells)
 variant=${RCFD_REGIMES_DATABASE_JOB:-database}
 read -r -a models <<< "${RCFD_REGIMES_MODELS:-mean streams relax}"
 solve=$(pwd)/build/rcfd-solve
