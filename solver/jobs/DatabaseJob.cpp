@@ -176,6 +176,8 @@ class DatabaseJob final : public JobRunner {
       progress->report(fraction(), sim.time(), true);
       startProgress();
       if (cancellationRequested() || options.stopAfterSteps == 0) cancelled("after settling");
+      // The filling is the longest stretch without one (an hour on the ProCell bed): keep it at once.
+      save();
     } else {
       writer = FieldDatabaseWriter::reopen(databasePath, sim.grid(), int(st.framesWritten));
     }

@@ -73,12 +73,18 @@ class DirectedRelaxationEffect final : public TracerEffect {
     excess_.setZero(Eigen::Index(open_.size()));
     w_.setZero(Eigen::Index(open_.size()));
     faceVelocity_.assign(6 * std::size_t(cells), 0.0f);
+    cellLower_.resize(3 * std::size_t(cells));
+    for (std::int64_t c = 0; c < cells; ++c) {
+      const auto ijk = grid.cellIjk(c);
+      for (int d = 0; d < 3; ++d)
+        cellLower_[3 * std::size_t(c) + std::size_t(d)] = grid.origin[d] + grid.spacing[d] * ijk[std::size_t(d)];
+    }
   }
 
   std::size_t allocatedBytes() const override {
     return (owner_ ? 3 * tracers_ * sizeof(float) : 0) + row_.capacity() * sizeof(std::int32_t) +
            (open_.capacity() + upperNeighbour_.capacity()) * sizeof(std::int32_t) + std::size_t(matrix_.nonZeros()) * (sizeof(double) + sizeof(int)) +
-           std::size_t(excess_.size() + w_.size()) * sizeof(double) + faceVelocity_.capacity() * sizeof(float);
+           std::size_t(excess_.size() + w_.size()) * sizeof(double) + faceVelocity_.capacity() * sizeof(float) + cellLower_.capacity() * sizeof(double);
   }
 
   void beforeMove(TracerContext& ctx) override {
@@ -96,15 +102,15 @@ class DirectedRelaxationEffect final : public TracerEffect {
     // position in the cell (the field whose divergence is the flux's).
     const std::int32_t* cellOf = ctx.tracerCell.data();
     const float* faces = faceVelocity_.data();
-    const CartesianGrid& grid = ctx.grid;
+    const double* lowerCorner = cellLower_.data();
+    const double inverseSpacing[3] = {1.0 / ctx.grid.spacing.x(), 1.0 / ctx.grid.spacing.y(), 1.0 / ctx.grid.spacing.z()};
     const double* position[3] = {ctx.cloud.x.data(), ctx.cloud.y.data(), ctx.cloud.z.data()};
 #pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
     for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
       const std::size_t c = std::size_t(cellOf[i]);
-      const auto ijk = grid.cellIjk(std::int64_t(c));
       for (int d = 0; d < 3; ++d) {
-        const double lower = grid.origin[d] + grid.spacing[d] * ijk[std::size_t(d)];
-        const double s = std::clamp((position[d][i] - lower) / grid.spacing[d], 0.0, 1.0);
+        const double s =
+            std::clamp((position[d][i] - lowerCorner[3 * c + std::size_t(d)]) * inverseSpacing[d], 0.0, 1.0);
         const double u = (1.0 - s) * double(faces[6 * c + 2 * std::size_t(d)]) + s * double(faces[6 * c + 2 * std::size_t(d) + 1]);
         out[d][i] = owner_ ? float(u) : out[d][i] + float(u);
       }
@@ -179,7 +185,11 @@ class DirectedRelaxationEffect final : public TracerEffect {
   void faceVelocities(const TracerContext& ctx) {
     const CartesianGrid& grid = ctx.grid;
     std::fill(faceVelocity_.begin(), faceVelocity_.end(), 0.0f);
-    for (std::size_t r = 0; r < open_.size(); ++r) {
+    const std::int64_t rows = std::int64_t(open_.size());
+    // Each face is written by its lower cell only: rows are independent.
+#pragma omp parallel for schedule(static) if (rows > kParallelThreshold)
+    for (std::int64_t rr = 0; rr < rows; ++rr) {
+      const std::size_t r = std::size_t(rr);
       const std::size_t c = std::size_t(open_[r]);
       const double here = w_[Eigen::Index(r)];
       for (int d = 0; d < 3; ++d) {  // each face once, from its lower cell
@@ -211,6 +221,7 @@ class DirectedRelaxationEffect final : public TracerEffect {
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver_;
   Eigen::VectorXd excess_, w_;
   std::vector<float> faceVelocity_;  ///< per cell: u_relax at its faces (x-, x+, y-, y+, z-, z+) [m/s]
+  std::vector<double> cellLower_;    ///< per cell: its lower corner (x, y, z) [m]
 };
 
 const bool registered = TracerEffectRegistry::add(
