@@ -186,8 +186,10 @@ class DirectedRelaxationEffect final : public TracerEffect {
     const CartesianGrid& grid = ctx.grid;
     std::fill(faceVelocity_.begin(), faceVelocity_.end(), 0.0f);
     const std::int64_t rows = std::int64_t(open_.size());
-    // Each face is written by its lower cell only: rows are independent.
-#pragma omp parallel for schedule(static) if (rows > kParallelThreshold)
+    // Each face is written by its lower cell only: rows are independent. A row is a few operations, so
+    // only paper-size grids pay for a parallel region (on a loaded machine its barrier costs more than
+    // the quick slice's whole loop).
+#pragma omp parallel for schedule(static) if (rows > 8 * kParallelThreshold)
     for (std::int64_t rr = 0; rr < rows; ++rr) {
       const std::size_t r = std::size_t(rr);
       const std::size_t c = std::size_t(open_[r]);
@@ -214,11 +216,11 @@ class DirectedRelaxationEffect final : public TracerEffect {
   std::vector<std::int32_t> row_;   ///< per cell: its row among the open cells, or -1
   std::vector<std::int32_t> open_;  ///< per row: its cell
   std::vector<std::int32_t> upperNeighbour_;  ///< per row and axis: the row of the open cell above, or -1
-  // Column-major: Eigen runs the solver's products on one thread then. Its OpenMP products (row-major
-  // with Lower|Upper) open a parallel region per iteration, whose barriers cost more than the small
-  // solve on a loaded machine.
+  // The self-adjoint product of the lower triangle runs on one thread. With Lower|Upper Eigen takes a
+  // row-major product, which opens an OpenMP region per iteration: on a loaded machine its barriers
+  // cost several times the small solve.
   Eigen::SparseMatrix<double> matrix_;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver_;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower> solver_;
   Eigen::VectorXd excess_, w_;
   std::vector<float> faceVelocity_;  ///< per cell: u_relax at its faces (x-, x+, y-, y+, z-, z+) [m/s]
   std::vector<double> cellLower_;    ///< per cell: its lower corner (x, y, z) [m]
