@@ -125,3 +125,14 @@ TEST(DirectedRelaxation, ZeroD0LeavesTheTracersWhereTheyAre) {
   EXPECT_EQ(start->cloud().inIdOrder(start->cloud().x), sim->cloud().inIdOrder(sim->cloud().x));
   EXPECT_EQ(start->cloud().inIdOrder(start->cloud().y), sim->cloud().inIdOrder(sim->cloud().y));
 }
+
+TEST(DirectedRelaxation, AllocatesOnlyWhenListed) {
+  const RestingBox with(kDirected, 1e-2, false);
+  const auto listed = runBox(with, 1);
+  EXPECT_GT(listed->allocatedBytes("directed_relaxation"), 6000 * 3 * sizeof(float));
+  EXPECT_EQ(listed->context().streamVelocity[0].size(), std::size_t(6000));
+  const RestingBox without(kEq10, 1e-2, false);
+  const auto plain = runBox(without, 1);
+  EXPECT_EQ(plain->allocatedBytes("directed_relaxation"), 0u);
+  EXPECT_TRUE(plain->context().streamVelocity[0].empty());
+}
