@@ -196,7 +196,8 @@ class DatabaseJob final : public JobRunner {
       if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {
         // The reference coverage steps from every sample of the reference period to the next.
         if (coverage && rec->samples() >= plan.sampledSamples()) {
-          coverage->step(sim.dem().particles(), std::make_shared<const FieldFrame>(sampleFrame(sim, false)));
+          const DemParticles& parcels = sim.dem().particles();
+          coverage->step(parcels.x, parcels.id, std::make_shared<const FieldFrame>(sampleFrame(sim, false)));
         }
         rec->record(sim.particleVelocity(), sim.pressureDrop(), sim.dem().particles());
         const DemParticles& p = sim.dem().particles();

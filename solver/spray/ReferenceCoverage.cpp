@@ -45,16 +45,20 @@ ReferenceCoverage::ReferenceCoverage(const Scene& scene, const Apparatus& appara
 
 ReferenceCoverage::~ReferenceCoverage() = default;
 
-void ReferenceCoverage::step(const DemParticles& parcels, std::shared_ptr<const FieldFrame> fields) {
+void ReferenceCoverage::step(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::uint64_t>& ids,
+                             std::shared_ptr<const FieldFrame> fields) {
   auto& ctx = *context_;
   auto& cloud = *cloud_;
-  if (parcels.size() != cloud.size()) {
-    throw RunError("reference coverage: " + std::to_string(parcels.size()) + " parcels, expected " +
+  if (positions.size() != cloud.size() || ids.size() != cloud.size()) {
+    throw RunError("reference coverage: " + std::to_string(positions.size()) + " parcels, expected " +
                    std::to_string(cloud.size()));
   }
   // Index = permanent id: the hand-out of droplets within a cell runs in index order, and results are
   // written per parcel id.
-  for (std::size_t i = 0; i < parcels.size(); ++i) cloud.setPosition(std::size_t(parcels.id[i]), parcels.x[i]);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    if (ids[i] >= cloud.size()) throw RunError("reference coverage: parcel id " + std::to_string(ids[i]) + " out of range");
+    cloud.setPosition(std::size_t(ids[i]), positions[i]);
+  }
   ctx.frame = std::move(fields);
   ctx.nextFrame = nullptr;
   ctx.blend = 0.0;

@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include "cfddem/DemParticles.hpp"
 #include "fields/FieldDatabase.hpp"
 #include "geometry/Apparatus.hpp"
 #include "scene/Scene.hpp"
@@ -43,9 +42,10 @@ class ReferenceCoverage {
                     const std::vector<double>& openFraction, std::size_t parcels, double dt, std::uint64_t seed);
   ~ReferenceCoverage();
 
-  /// One step of dt from the present instant: `parcels` where they are now (by permanent id) and the
-  /// fields of the instant (alpha_P, u_P, u_G).
-  void step(const DemParticles& parcels, std::shared_ptr<const FieldFrame> fields);
+  /// One step of dt from the present instant: the parcels where they are now (`positions[i]` of the
+  /// parcel with permanent id `ids[i]`) and the fields of the instant (alpha_P, u_P, u_G).
+  void step(const std::vector<Eigen::Vector3d>& positions, const std::vector<std::uint64_t>& ids,
+            std::shared_ptr<const FieldFrame> fields);
 
   std::int64_t steps() const;
   double duration() const;  ///< steps x dt [s]

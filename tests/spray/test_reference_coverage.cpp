@@ -9,7 +9,6 @@
 
 #include "analysis/CoverageComparison.hpp"
 #include "analysis/ReferenceStatistics.hpp"
-#include "cfddem/DemParticles.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
 #include "spray/Coverage.hpp"
@@ -38,11 +37,17 @@ struct RestingBed {
   }
 };
 
-DemParticles parcelsAt(const TracerCloud& cloud) {
-  DemParticles p;
+/// The positions and ids of a tracer cloud, as the database job hands the parcels over.
+struct Parcels {
+  std::vector<Eigen::Vector3d> x;
+  std::vector<std::uint64_t> id;
+  std::size_t size() const { return x.size(); }
+};
+Parcels parcelsAt(const TracerCloud& cloud) {
+  Parcels p;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    p.add(cloud.position(i), Vec3::Zero(), 0.001, 1000.0);
-    p.id[i] = std::uint64_t(cloud.id[i]);
+    p.x.push_back(cloud.position(i));
+    p.id.push_back(std::uint64_t(cloud.id[i]));
   }
   return p;
 }
@@ -62,10 +67,10 @@ TEST(ReferenceCoverage, HandsOutExactlyTheDropletsOfATracerRunOnTheSamePositions
   settings.sortInterval = 0;  // index order = id order on both sides: the hand-out within a cell follows it
   TracerSimulation sim(bed.scene, bed.db, sequentialPath(bed.db->frameCount(), steps + 2), settings);
   ASSERT_NEAR(sim.cloud().particlesPerTracer, 8.0, 1e-9);
-  const DemParticles parcels = parcelsAt(sim.cloud());
+  const Parcels parcels = parcelsAt(sim.cloud());
   ReferenceCoverage ref = makeReference(bed, parcels.size());
   for (std::int64_t k = 0; k < steps; ++k) {
-    ref.step(parcels, sim.context().frame);  // the frame of the tracer run's step k
+    ref.step(parcels.x, parcels.id, sim.context().frame);  // the frame of the tracer run's step k
     sim.step();
   }
   EXPECT_EQ(ref.steps(), steps);
@@ -91,14 +96,14 @@ TEST(ReferenceCoverage, SavedAndLoadedMidwayEqualsUninterrupted) {
   RestingBed bed;
   TracerRunSettings settings{3, 10, 0};
   TracerSimulation placement(bed.scene, bed.db, sequentialPath(bed.db->frameCount(), 12), settings);
-  const DemParticles parcels = parcelsAt(placement.cloud());
+  const Parcels parcels = parcelsAt(placement.cloud());
   auto frame = [&](std::int64_t k) { return bed.db->frame(int(k % bed.db->frameCount())); };
   ReferenceCoverage whole = makeReference(bed, parcels.size());
-  for (std::int64_t k = 0; k < 300; ++k) whole.step(parcels, frame(k));
+  for (std::int64_t k = 0; k < 300; ++k) whole.step(parcels.x, parcels.id, frame(k));
   const std::string path = tempPath("reference-coverage-state.h5");
   {
     ReferenceCoverage first = makeReference(bed, parcels.size());
-    for (std::int64_t k = 0; k < 137; ++k) first.step(parcels, frame(k));
+    for (std::int64_t k = 0; k < 137; ++k) first.step(parcels.x, parcels.id, frame(k));
     h5::File f(path, h5::File::Mode::Create);
     first.save(f, "/state");
   }
@@ -108,7 +113,7 @@ TEST(ReferenceCoverage, SavedAndLoadedMidwayEqualsUninterrupted) {
     resumed.load(f, "/state");
   }
   EXPECT_EQ(resumed.steps(), 137);
-  for (std::int64_t k = 137; k < 300; ++k) resumed.step(parcels, frame(k));
+  for (std::int64_t k = 137; k < 300; ++k) resumed.step(parcels.x, parcels.id, frame(k));
   EXPECT_EQ(resumed.dropletsPerParticle(), whole.dropletsPerParticle());
   EXPECT_EQ(resumed.summary().dump(), whole.summary().dump());
   std::filesystem::remove(path);
@@ -117,9 +122,9 @@ TEST(ReferenceCoverage, SavedAndLoadedMidwayEqualsUninterrupted) {
 TEST(ReferenceCoverage, WrittenIntoTheDatabaseAndReadBack) {
   RestingBed bed;
   TracerSimulation placement(bed.scene, bed.db, sequentialPath(bed.db->frameCount(), 12), {3, 10, 0});
-  const DemParticles parcels = parcelsAt(placement.cloud());
+  const Parcels parcels = parcelsAt(placement.cloud());
   ReferenceCoverage ref = makeReference(bed, parcels.size());
-  for (std::int64_t k = 0; k < 200; ++k) ref.step(parcels, bed.db->frame(int(k % bed.db->frameCount())));
+  for (std::int64_t k = 0; k < 200; ++k) ref.step(parcels.x, parcels.id, bed.db->frame(int(k % bed.db->frameCount())));
   const std::string path = tempPath("reference-coverage-db.h5");
   {
     h5::File f(path, h5::File::Mode::Create);
