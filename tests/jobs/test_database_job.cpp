@@ -279,8 +279,10 @@ TEST_F(DatabaseJob, StoppedAndResumedEqualsUninterrupted) {
 // With the gas: a tiny prismatic bed (200 parcels, 1,440 cells) through ramp, warm-up and sampling;
 // stopped during sampling and resumed, frames (u_G included), pressure drop and probe signals agree
 // with the uninterrupted job's to 1e-6 (not bit for bit: see expectCloseDatabase).
-TEST_F(DatabaseJob, GasJobStoppedAndResumedEqualsUninterrupted) {
-  const json scene = json::parse(R"({
+/// A tiny prismatic bed with the gas (200 parcels, 1,440 cells) through ramp, warm-up, 15 ms of
+/// sampling and 5 ms of reference.
+json gasScene() {
+  return json::parse(R"({
     "name": "database-gas-test",
     "apparatus": {"type": "prismatic_spouted_bed", "width": 0.06, "depth": 0.01, "height": 0.3,
                   "prism_angle_deg": 60, "inlet_width": 0.01},
@@ -296,6 +298,10 @@ TEST_F(DatabaseJob, GasJobStoppedAndResumedEqualsUninterrupted) {
     "effects": ["gas", "drag", "smoothing", "rolling_friction"],
     "outputs": {"svg": false}
   })");
+}
+
+TEST_F(DatabaseJob, GasJobStoppedAndResumedEqualsUninterrupted) {
+  const json scene = gasScene();
   writeJob(scene, "gas.json");
   ASSERT_EQ(solve(run("a", "", "gas.json")).exitCode, 0);
   ASSERT_EQ(solve(run("b", "--stop-after-steps 450", "gas.json")).exitCode, 130);
@@ -321,23 +327,12 @@ TEST_F(DatabaseJob, GasJobStoppedAndResumedEqualsUninterrupted) {
 // A scene that asks for the coverage gets the full simulation's own: the spray model on the parcels over
 // the reference period, one value per parcel, books that close, stepped at the reference samples.
 TEST_F(DatabaseJob, RecordsTheReferenceCoverageWhenTheSceneAsksForTheCoverage) {
-  json scene = json::parse(R"({
-    "name": "database-coverage-test",
-    "apparatus": {"type": "prismatic_spouted_bed", "width": 0.06, "depth": 0.01, "height": 0.3,
-                  "prism_angle_deg": 60, "inlet_width": 0.01},
-    "grid": {"cell_size": 0.005},
-    "gas": {"max_time_step": 5e-5},
-    "particles": {},
-    "process": {"gas_flow_rate": 2e-4, "atomisation_flow_rate": 1e-6, "bed_mass": 6.4e-4},
-    "spray": {"nozzle_position": [0.0, 0.0, 0.005], "nozzle_diameter": 0.002, "parcels_per_s": 20000,
-              "spray_zone": {"apex": [0.0, 0.0, 0.005], "half_angle_deg": 30, "y_min": 0.005, "y_max": 0.04}},
-    "dem": {"time_step": 1e-5, "coupling_interval": 5, "settle_time": 0.05, "ramp_time": 0.01, "warmup": 0.01,
-            "sample_rate": 200, "probe_rate": 1000, "sample_duration": 0.015, "reference_duration": 0.02},
-    "probes": [{"name": "spout", "position": [0.0, 0.02, 0.005]}],
-    "effects": ["gas", "drag", "smoothing", "rolling_friction", "tracer_volume_fraction", "spray", "deposition",
-                "coverage"],
-    "outputs": {"svg": false}
-  })");
+  json scene = gasScene();
+  scene["name"] = "database-coverage-test";
+  scene["spray"]["parcels_per_s"] = 20000;
+  scene["dem"]["reference_duration"] = 0.02;
+  scene["effects"] = json::array({"gas", "drag", "smoothing", "rolling_friction", "tracer_volume_fraction", "spray",
+                                  "deposition", "coverage"});
   writeJob(scene, "coverage.json");
   ASSERT_EQ(solve(run("a", "", "coverage.json")).exitCode, 0);
   const json s = summaryOf(dir_ / "a");
