@@ -195,26 +195,25 @@ TEST(CoverageComparison, AMalformedReferenceIsAnErrorNamingTheDataset) {
     f.write("/frames/alpha_p", std::vector<double>{0.0});
   }
   EXPECT_FALSE(analysis::readReferenceCoverage(path).has_value());  // none: nothing to compare
+  // Reading the file is an InputError whose message names `mention`.
+  auto expectRefusal = [&](const std::string& what, const std::string& mention) {
+    try {
+      analysis::readReferenceCoverage(path);
+      ADD_FAILURE() << what << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
+    }
+  };
   {
     h5::File f(path, h5::File::Mode::ReadWrite);
     f.write(analysis::reference_layout::coverageDroplets, std::vector<double>{1.0, -2.0});
   }
-  try {
-    analysis::readReferenceCoverage(path);
-    FAIL() << "a negative droplet count was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("droplets_per_particle"), std::string::npos) << e.what();
-  }
+  expectRefusal("a negative droplet count", "droplets_per_particle");
   std::filesystem::remove(path);
   {
     h5::File f(path, h5::File::Mode::Create);
     f.write(analysis::reference_layout::coverageDroplets, std::vector<double>{1.0, 2.0});
   }
-  try {
-    analysis::readReferenceCoverage(path);
-    FAIL() << "missing attributes were accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("duration_s"), std::string::npos) << e.what();
-  }
+  expectRefusal("missing attributes", "duration_s");
   std::filesystem::remove(path);
 }
