@@ -156,5 +156,61 @@ TEST(FieldSmoother, Equation3IsConservativeAndBounded) {
   EXPECT_GE(minAfter, 0.0);        // no negative fractions
 }
 
+TEST(VolumeMapping, MomentsGiveTheSameMeanAndSpreadAsTheDirectSums) {
+  SliceMapping m;
+  test::scatterParcels(m.dem, m.apparatus, 3000, m.dem.material().particle_radius, 12, 0.3);
+  DemParticles& p = m.dem.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.v[i] = Eigen::Vector3d(0.3 * std::sin(double(i)), i % 3 == 0 ? 2.0 : -0.5, 0.1 * std::cos(double(i)));
+  }
+  std::vector<KernelWeights> w;
+  m.mapping.weightsOf(p, w);
+  const auto direct = m.mapping.velocitySpread(p, w);
+  const auto fromMoments = VolumeMapping::spreadOf(m.mapping.velocityMoments(p, w));
+  for (std::size_t c = 0; c < direct.mean.size(); ++c) {
+    EXPECT_NEAR((fromMoments.mean[c] - direct.mean[c]).norm(), 0.0, 1e-12) << c;
+    EXPECT_NEAR(fromMoments.upFraction[c], direct.upFraction[c], 1e-12) << c;
+    EXPECT_NEAR((fromMoments.up[c] - direct.up[c]).norm(), 0.0, 1e-12) << c;
+    EXPECT_NEAR((fromMoments.down[c] - direct.down[c]).norm(), 0.0, 1e-12) << c;
+    EXPECT_NEAR((fromMoments.variance[c] - direct.variance[c]).norm(), 0.0, 1e-9) << c;
+  }
+}
+
+TEST(FieldSmoother, SmoothedMomentsGiveEveryCellTheSmoothingFillsTheVelocityItsVolumeCarries) {
+  // Parcels of one velocity: the smoothing spreads their volume into cells no kernel reaches, and the
+  // frames' u_P must be that velocity there too (the unsmoothed momentum over the smoothed alpha_P
+  // would leave those cells, and the tracers in them, at rest), with the momentum conserved.
+  SliceMapping m;
+  test::scatterParcels(m.dem, m.apparatus, 40, m.dem.material().particle_radius, 13, 0.3);
+  DemParticles& p = m.dem.particles();
+  const Eigen::Vector3d velocity(0.4, 1.5, -0.2);
+  for (auto& v : p.v) v = velocity;
+  std::vector<KernelWeights> w;
+  m.mapping.weightsOf(p, w);
+  auto moments = m.mapping.velocityMoments(p, w);
+  const FieldSmoother s(m.mapping, m.gas.faceKinds(0), m.gas.faceKinds(1), m.gas.faceKinds(2),
+                        m.scene.gas.smoothing_length);
+  std::size_t reachedBefore = 0, reachedAfter = 0;
+  for (double a : moments.alpha) reachedBefore += a > 0.0;
+  s.smooth(moments.alpha);
+  s.smooth(moments.alphaUp);
+  s.smooth(moments.momentum);
+  s.smooth(moments.momentumUp);
+  s.smooth(moments.secondMoment);
+  const auto spread = VolumeMapping::spreadOf(moments);
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  for (std::size_t c = 0; c < spread.mean.size(); ++c) {
+    if (!(moments.alpha[c] > 0.0)) continue;
+    ++reachedAfter;
+    EXPECT_NEAR((spread.mean[c] - velocity).norm(), 0.0, 1e-12) << c;
+    EXPECT_NEAR(spread.upFraction[c], 1.0, 1e-12) << c;
+    EXPECT_NEAR(spread.variance[c].norm(), 0.0, 1e-12) << c;
+    momentum += moments.alpha[c] * m.mapping.openVolume(c) * spread.mean[c];
+  }
+  EXPECT_GT(reachedAfter, 2 * reachedBefore);
+  const Eigen::Vector3d expected = totalParcelVolume(p) * velocity;
+  EXPECT_NEAR((momentum - expected).norm(), 0.0, 1e-12 * expected.norm());
+}
+
 }  // namespace
 }  // namespace rcfd

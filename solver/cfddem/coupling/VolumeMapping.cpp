@@ -214,4 +214,58 @@ VolumeMapping::VelocitySpread VolumeMapping::velocitySpread(const DemParticles& 
   return s;
 }
 
+VolumeMapping::VelocityMoments VolumeMapping::velocityMoments(const DemParticles& p,
+                                                             const std::vector<KernelWeights>& w) const {
+  const std::size_t cells = phi_.size();
+  VelocityMoments m;
+  m.alpha.assign(cells, 0.0);
+  m.alphaUp.assign(cells, 0.0);
+  m.momentum.assign(cells, Eigen::Vector3d::Zero());
+  m.momentumUp.assign(cells, Eigen::Vector3d::Zero());
+  m.secondMoment.assign(cells, Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < p.size(); ++i) {  // serial scatter in index order: deterministic sums
+    const double v = parcelVolume(p, i);
+    const bool up = p.v[i].y() > 0.0;
+    for (int k = 0; k < w[i].count; ++k) {
+      const std::size_t c = std::size_t(w[i].cell[std::size_t(k)]);
+      const double wv = w[i].w[std::size_t(k)] * v;
+      m.alpha[c] += wv;
+      m.momentum[c] += wv * p.v[i];
+      m.secondMoment[c] += wv * p.v[i].cwiseAbs2();
+      if (up) {
+        m.alphaUp[c] += wv;
+        m.momentumUp[c] += wv * p.v[i];
+      }
+    }
+  }
+  for (std::size_t c = 0; c < cells; ++c) {
+    const double open = openVolume(c);
+    const double inv = open > 0.0 ? 1.0 / open : 0.0;
+    m.alpha[c] *= inv, m.alphaUp[c] *= inv;
+    m.momentum[c] *= inv, m.momentumUp[c] *= inv, m.secondMoment[c] *= inv;
+  }
+  return m;
+}
+
+VolumeMapping::VelocitySpread VolumeMapping::spreadOf(const VelocityMoments& m) {
+  const std::size_t cells = m.alpha.size();
+  VelocitySpread s;
+  s.mean.assign(cells, Eigen::Vector3d::Zero());
+  s.up.assign(cells, Eigen::Vector3d::Zero());
+  s.down.assign(cells, Eigen::Vector3d::Zero());
+  s.variance.assign(cells, Eigen::Vector3d::Zero());
+  s.upFraction.assign(cells, 0.0);
+  for (std::size_t c = 0; c < cells; ++c) {
+    const double a = m.alpha[c];
+    if (!(a > 0.0)) continue;
+    s.mean[c] = m.momentum[c] / a;
+    const double up = std::clamp(m.alphaUp[c], 0.0, a), down = a - up;
+    s.upFraction[c] = up / a;
+    s.up[c] = up > 0.0 ? Eigen::Vector3d(m.momentumUp[c] / up) : s.mean[c];
+    s.down[c] = down > 0.0 ? Eigen::Vector3d((m.momentum[c] - m.momentumUp[c]) / down) : s.mean[c];
+    s.variance[c] = (m.secondMoment[c] / a - s.mean[c].cwiseAbs2()).cwiseMax(0.0);
+  }
+  return s;
+}
+
 }  // namespace rcfd::coupling
