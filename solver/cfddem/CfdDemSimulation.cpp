@@ -144,7 +144,6 @@ std::vector<double> CfdDemSimulation::particleFraction() const {
 }
 
 std::vector<Eigen::Vector3d> CfdDemSimulation::particleVelocity() const {
-  if (coupling_->fluid) return coupling_->fluid->currentVelocity();  // consistent with particleFraction()
   const auto& map = coupling_->map();
   std::vector<coupling::KernelWeights> w;
   map.weightsOf(dem_->particles(), w);
@@ -152,7 +151,6 @@ std::vector<Eigen::Vector3d> CfdDemSimulation::particleVelocity() const {
 }
 
 coupling::VolumeMapping::VelocitySpread CfdDemSimulation::particleVelocitySpread() const {
-  if (coupling_->fluid) return coupling_->fluid->currentVelocitySpread();
   const auto& map = coupling_->map();
   std::vector<coupling::KernelWeights> w;
   map.weightsOf(dem_->particles(), w);

@@ -53,34 +53,6 @@ std::vector<double> FluidCoupling::currentFraction() const {
   return mapping_->fractionOf(volume);
 }
 
-VolumeMapping::VelocitySpread FluidCoupling::currentVelocitySpread() const {
-  std::vector<KernelWeights> w;
-  mapping_->weightsOf(dem_.particles(), w);
-  if (!smoother_) return mapping_->velocitySpread(dem_.particles(), w);
-  auto m = mapping_->velocityMoments(dem_.particles(), w);
-  smoother_->smooth(m.alpha);
-  smoother_->smooth(m.alphaUp);
-  smoother_->smooth(m.momentum);
-  smoother_->smooth(m.momentumUp);
-  smoother_->smooth(m.secondMoment);
-  return VolumeMapping::spreadOf(m);
-}
-
-std::vector<Eigen::Vector3d> FluidCoupling::currentVelocity() const {
-  std::vector<KernelWeights> w;
-  mapping_->weightsOf(dem_.particles(), w);
-  if (!smoother_) return mapping_->meanVelocity(dem_.particles(), w);
-  auto m = mapping_->velocityMoments(dem_.particles(), w);
-  // alpha_P and the momentum through one smoothing, as four components.
-  std::vector<Eigen::Vector4d> field(m.alpha.size());
-  for (std::size_t c = 0; c < field.size(); ++c) field[c] << m.alpha[c], m.momentum[c];
-  smoother_->smooth(field);
-  std::vector<Eigen::Vector3d> u(field.size(), Eigen::Vector3d::Zero());
-  for (std::size_t c = 0; c < field.size(); ++c)
-    if (field[c][0] > 0.0) u[c] = field[c].tail<3>() / field[c][0];
-  return u;
-}
-
 void FluidCoupling::prepare(double interval) {
   const DemParticles& p = dem_.particles();
   const std::size_t n = p.size(), cells = alphaP_.size();

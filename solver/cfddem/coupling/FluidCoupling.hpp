@@ -48,12 +48,6 @@ class FluidCoupling {
   /// alpha_P of the current parcels, processed as prepare() does (smoothing, redistribution), without
   /// touching the gas [-].
   std::vector<double> currentFraction() const;
-  /// The parcels' mean velocity (and its spread) consistent with currentFraction(): with smoothing, the
-  /// momenta are smoothed with alpha_P and divided by it afterwards, so alpha_P u_P is the smoothed
-  /// momentum and every cell the smoothing gives particle volume also gets the velocity that volume
-  /// carries (dividing the unsmoothed momentum would leave it at rest).
-  std::vector<Eigen::Vector3d> currentVelocity() const;
-  VolumeMapping::VelocitySpread currentVelocitySpread() const;
   /// alpha_P per cell after smoothing and redistribution [-].
   const std::vector<double>& particleFraction() const { return alphaP_; }
   const std::vector<double>& gasFraction() const { return alphaG_; }

@@ -73,18 +73,6 @@ class VolumeMapping {
   };
   VelocitySpread velocitySpread(const DemParticles& p, const std::vector<KernelWeights>& w) const;
 
-  /// The same statistics as moments per open volume, which a smoother can act on before they are
-  /// divided: alpha_P, alpha_P of the upward volume, the momenta alpha_P u of all and of the upward
-  /// volume, and alpha_P <u^2> per component (0 in unusable cells).
-  struct VelocityMoments {
-    std::vector<double> alpha, alphaUp;
-    std::vector<Eigen::Vector3d> momentum, momentumUp, secondMoment;
-  };
-  VelocityMoments velocityMoments(const DemParticles& p, const std::vector<KernelWeights>& w) const;
-  /// Mean velocity and spread of moments (what meanVelocity() and velocitySpread() give for unsmoothed
-  /// moments, to round-off): the cell's mean where a part holds no volume, zero in an empty cell.
-  static VelocitySpread spreadOf(const VelocityMoments& m);
-
   /// Interpolates a cell field to a point with weights w.
   template <class T>
   static T interpolate(const std::vector<T>& field, const KernelWeights& w) {
