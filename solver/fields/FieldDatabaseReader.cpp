@@ -291,7 +291,7 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
     for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
       const auto& f = kVelocitySpreadFields[k];
       if (!hdf5::linkExists(reader->file, f.path)) {
-        v.push_back({f.path, "dataset is missing: the velocity spread (velocity_streams) needs it; the database "
+        v.push_back({f.path, "dataset is missing: the velocity spread (velocity_streams, langevin_velocity) needs it; the database "
                              "job writes it, a database from elsewhere can add it (docs/formats.md)"});
         continue;
       }

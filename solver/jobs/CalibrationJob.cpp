@@ -43,7 +43,7 @@ const std::vector<std::string> kCalibrationEffects = {"transport", "free_flight"
 /// when it lists none...
 const std::vector<std::string> kRelaxationModels = {"fluctuation", "directed_relaxation"};
 /// ...and the motion models of the scene's list that change how tracers move (calibrated with them).
-const std::vector<std::string> kCalibratedModels = {"velocity_streams"};
+const std::vector<std::string> kCalibratedModels = {"velocity_streams", "langevin_velocity"};
 
 std::vector<std::string> calibrationEffects(const Scene& scene) {
   std::vector<std::string> effects = {kCalibrationEffects.front()};

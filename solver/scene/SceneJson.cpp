@@ -124,6 +124,7 @@ Scene sceneFromJson(const json& document) {
   read(r, "d0", s.rcfd.d0);
   read(r, "u_fluc_max", s.rcfd.u_fluc_max);
   read(r, "free_flight_alpha", s.rcfd.free_flight_alpha);
+  read(r, "langevin_time", s.rcfd.langevin_time);
   read(r, "fluctuation_model", s.rcfd.fluctuation_model);
   read(r, "max_courant", s.rcfd.max_courant);
   read(r, "integrator", s.rcfd.integrator);
@@ -198,7 +199,7 @@ json sceneToJson(const Scene& s) {
                 {"reference_duration", d.reference_duration}};
   const auto& r = s.rcfd;
   doc["rcfd"] = {{"dt", r.dt}, {"tracers", r.tracers}, {"d0", r.d0}, {"u_fluc_max", r.u_fluc_max},
-                 {"free_flight_alpha", r.free_flight_alpha}, {"fluctuation_model", r.fluctuation_model},
+                 {"free_flight_alpha", r.free_flight_alpha}, {"langevin_time", r.langevin_time}, {"fluctuation_model", r.fluctuation_model},
                  {"max_courant", r.max_courant}, {"integrator", r.integrator},
                  {"frame_cache_bytes", r.frame_cache_bytes},
                  {"path", {{"type", r.path.type}, {"min_sequence_fraction", r.path.min_sequence_fraction},

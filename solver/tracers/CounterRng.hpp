@@ -29,6 +29,7 @@ enum class RngPurpose : std::uint64_t {
   Test = 5,
   Deposition = 6,
   Streams = 7,
+  Langevin = 8,
 };
 
 /// The part of a CounterRng key shared by every stream of one (seed, purpose, step), hoisted out of

@@ -1,0 +1,216 @@
+// langevin_velocity: the velocity spread the cell mean u_P^rec loses, restored as an Ornstein-Uhlenbeck
+// velocity on the frames' own variance. Where rising and falling particles share a cell their mean is
+// slow, and tracers moving with it linger where the particles shoot through (long spray-zone stays,
+// too few crossings); the variance of the particle velocities about that mean (/frames/u_p_variance,
+// the granular temperature per component, at the scale of the mean) says how fast they really move.
+// Every tracer carries a fluctuation u' (per component d, variance sigma_d^2 of its cell in the step's
+// frame), integrated exactly over the step for constant coefficients:
+//   u'_d <- a u'_d + (1 - a) T g_d + sigma_d sqrt(1 - a^2) xi,   a = exp(-dt / T),
+// with T = rcfd.langevin_time, xi standard normal (a counter-based stream per tracer and step), and the
+// drift g_d = d(alpha_P sigma_d^2)/dx_d / alpha_P: in the diffusive limit the tracer flux is then
+// -T grad(sigma^2 n) + n T g, which vanishes for n proportional to alpha_P^rec, so the fluctuation
+// does not move tracers out of where the recurrence field puts them (the well-mixed condition of
+// Thomson 1987, in its mean-drift form). |T g| is capped at rcfd.u_fluc_max. u' is added to Eq. (9)
+// over the step (TracerContext::streamVelocity, after velocity_streams and directed_relaxation when
+// those are listed).
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "core/Errors.hpp"
+#include "core/Permutation.hpp"
+#include "tracers/CounterRng.hpp"
+#include "tracers/TracerEffect.hpp"
+#include "tracers/Trilinear.hpp"
+
+namespace rcfd {
+namespace {
+
+class LangevinVelocityEffect final : public TracerEffect {
+ public:
+  explicit LangevinVelocityEffect(TracerContext& ctx)
+      : time_(ctx.scene.rcfd.langevin_time), cap_(ctx.scene.rcfd.u_fluc_max), tracers_(ctx.cloud.size()) {
+    const std::size_t n = tracers_;
+    owner_ = ctx.streamVelocity[0].size() != n;
+    if (owner_) {
+      for (auto& v : ctx.streamVelocity) v.assign(n, 0.0f);
+    }
+    for (auto& v : fluctuation_) v.assign(n, 0.0f);
+    halfSpaces_ = ctx.apparatus.convexHalfSpaces();
+    for (const auto& plate : ctx.apparatus.holes()) {
+      Eigen::Vector2d lo = plate[0], hi = plate[0];
+      for (const auto& v : plate) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      plates_.push_back({lo, hi});
+    }
+    margin_ = 2.0 * ctx.apparatus.boundaryTolerance();
+    const std::int64_t cells = ctx.grid.cellCount();
+    sigma_.assign(3 * std::size_t(cells), 0.0f);
+    drift_.assign(3 * std::size_t(cells), 0.0f);
+    moment_.assign(std::size_t(cells), 0.0);
+    alpha_.assign(std::size_t(cells), 0.0);
+  }
+
+  std::size_t allocatedBytes() const override {
+    return (owner_ ? 3 * tracers_ * sizeof(float) : 0) + 3 * tracers_ * sizeof(float) +
+           (sigma_.capacity() + drift_.capacity()) * sizeof(float) +
+           (moment_.capacity() + alpha_.capacity()) * sizeof(double);
+  }
+
+  void beforeMove(TracerContext& ctx) override {
+    const FieldFrame& a = *ctx.frame;
+    if (!a.hasVelocitySpread())
+      throw RunError("langevin_velocity needs the frames' velocity spread (/frames/u_p_variance), which " +
+                     (ctx.database ? ctx.database->path() : std::string("the frames")) + " does not hold");
+    cellFields(ctx);
+    const std::size_t n = ctx.cloud.size();
+    const double decay = std::exp(-ctx.dt / time_);
+    const double kick = std::sqrt(std::max(0.0, 1.0 - decay * decay));
+    const CounterRngPrefix prefix(ctx.seed, RngPurpose::Langevin, std::uint64_t(ctx.step));
+    const std::int32_t* id = ctx.cloud.id.data();
+    const TrilinearLocator::Constants locator = TrilinearLocator(ctx.grid).constants();
+    const std::int32_t corner[8] = {0, 1, locator.sy, locator.sy + 1, locator.sz, locator.sz + 1,
+                                    locator.sz + locator.sy, locator.sz + locator.sy + 1};
+    const double* position[3] = {ctx.cloud.x.data(), ctx.cloud.y.data(), ctx.cloud.z.data()};
+    float* out[3] = {ctx.streamVelocity[0].data(), ctx.streamVelocity[1].data(), ctx.streamVelocity[2].data()};
+    float* u[3] = {fluctuation_[0].data(), fluctuation_[1].data(), fluctuation_[2].data()};
+    const float* sigma = sigma_.data();
+    const float* drift = drift_.data();
+    const double relax = 1.0 - decay;
+    const bool owner = owner_;
+#pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
+    for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
+      // sigma and the drift at the tracer's position, trilinear between cell centres: the drift's
+      // gradient within a cell then keeps the tracers' density there as alpha_P^rec varies.
+      double f[3];
+      const std::size_t base = std::size_t(locator.locate(position[0][i], position[1][i], position[2][i], f[0], f[1], f[2]));
+      double sigmaAt[3] = {0.0, 0.0, 0.0}, driftAt[3] = {0.0, 0.0, 0.0};
+      for (int k = 0; k < 8; ++k) {
+        const double w = ((k & 1) ? f[0] : 1.0 - f[0]) * ((k & 2) ? f[1] : 1.0 - f[1]) * ((k & 4) ? f[2] : 1.0 - f[2]);
+        const std::size_t c = base + std::size_t(corner[k]);
+        for (int d = 0; d < 3; ++d) {
+          sigmaAt[d] += w * double(sigma[3 * c + std::size_t(d)]);
+          driftAt[d] += w * double(drift[3 * c + std::size_t(d)]);
+        }
+      }
+      CounterRng rng(prefix, std::uint64_t(id[i]));
+      double xi[4];
+      for (int k = 0; k < 2; ++k) {  // Box-Muller: two pairs of standard normals
+        const double r = std::sqrt(-2.0 * std::log(1.0 - rng.uniform()));
+        const double phi = 2.0 * std::numbers::pi * rng.uniform();
+        xi[2 * k] = r * std::cos(phi), xi[2 * k + 1] = r * std::sin(phi);
+      }
+      Eigen::Vector3d next;
+      for (int d = 0; d < 3; ++d) next[d] = decay * double(u[d][i]) + relax * driftAt[d] + sigmaAt[d] * kick * xi[d];
+      reflectAtWalls(ctx.apparatus, Eigen::Vector3d(position[0][i], position[1][i], position[2][i]), ctx.dt, next);
+      for (int d = 0; d < 3; ++d) {
+        u[d][i] = float(next[d]);
+        out[d][i] = owner ? float(next[d]) : out[d][i] + float(next[d]);
+      }
+    }
+  }
+
+  void permuteTracers(TracerContext&, const std::vector<std::int32_t>& from) override {
+    for (auto& v : fluctuation_) applyPermutation(v, from);
+  }
+
+  void saveState(h5::File& f, const std::string& g) const override {
+    f.write(g + "/u_x", fluctuation_[0]);
+    f.write(g + "/u_y", fluctuation_[1]);
+    f.write(g + "/u_z", fluctuation_[2]);
+  }
+  void loadState(const h5::File& f, const std::string& g) override {
+    const char* names[3] = {"/u_x", "/u_y", "/u_z"};
+    for (int d = 0; d < 3; ++d) {
+      auto v = f.readFloats(g + names[d]);
+      if (v.size() != tracers_) throw InputError(f.path(), g + names[d], "does not hold one velocity per tracer");
+      fluctuation_[std::size_t(d)] = std::move(v);
+    }
+  }
+
+ private:
+  /// A fluctuation that would carry the tracer through a wall or plate within the step is reflected
+  /// at it, as a particle's velocity is: the walls reflect the tracer's position, and a fluctuation
+  /// kept pointing into the wall for the time scale T would hold tracers against it. Most tracers are
+  /// cleared by the convex half-spaces and the plates' boxes alone.
+  void reflectAtWalls(const Apparatus& apparatus, const Eigen::Vector3d& p, double dt, Eigen::Vector3d& u) const {
+    const Eigen::Vector3d q = p + dt * u;
+    bool clear = true;
+    for (const auto& h : halfSpaces_) clear = clear && h.n.dot(q) - h.c >= margin_;
+    for (const auto& b : plates_) {
+      const double lo[2] = {std::min(p.x(), q.x()), std::min(p.y(), q.y())};
+      const double hi[2] = {std::max(p.x(), q.x()), std::max(p.y(), q.y())};
+      clear = clear && (hi[0] < b.lo.x() - margin_ || lo[0] > b.hi.x() + margin_ || hi[1] < b.lo.y() - margin_ ||
+                        lo[1] > b.hi.y() + margin_);
+    }
+    if (clear || apparatus.signedDistance(p) < -apparatus.boundaryTolerance()) return;
+    const auto hit = apparatus.firstIntersection(p, q);
+    if (!hit) return;
+    const double into = u.dot(hit->normal);
+    if (into < 0.0) u -= 2.0 * into * hit->normal;
+  }
+
+  /// sigma_d and the drift T g_d of every cell for this step's frame (blended like alpha_P^rec).
+  void cellFields(const TracerContext& ctx) {
+    const FieldFrame& a = *ctx.frame;
+    const FieldFrame* b = ctx.nextFrame.get();
+    const double blend = b ? ctx.blend : 0.0;
+    const CartesianGrid& grid = ctx.grid;
+    const std::size_t cells = std::size_t(grid.cellCount());
+    auto mix = [&](const std::vector<float>& fa, const std::vector<float>* fb, std::size_t k) {
+      return fb ? (1.0 - blend) * double(fa[k]) + blend * double((*fb)[k]) : double(fa[k]);
+    };
+    for (std::size_t c = 0; c < cells; ++c) alpha_[c] = ctx.openVolume[c] > 0.0 ? mix(a.alpha_p, b ? &b->alpha_p : nullptr, c) : 0.0;
+    for (int d = 0; d < 3; ++d) {
+      for (std::size_t c = 0; c < cells; ++c) {
+        const double variance = std::max(0.0, mix(a.u_p_variance, b ? &b->u_p_variance : nullptr, 3 * c + std::size_t(d)));
+        sigma_[3 * c + std::size_t(d)] = float(std::sqrt(variance));
+        moment_[c] = alpha_[c] * variance;
+      }
+      const double h = grid.spacing[d];
+      for (std::size_t c = 0; c < cells; ++c) {
+        double g = 0.0;
+        if (alpha_[c] > 0.0) {
+          const auto ijk = grid.cellIjk(std::int64_t(c));
+          auto neighbour = [&](int side) -> std::int64_t {
+            auto nb = ijk;
+            nb[std::size_t(d)] += side;
+            if (nb[std::size_t(d)] < 0 || nb[std::size_t(d)] >= grid.shape[std::size_t(d)]) return -1;
+            const std::int64_t o = grid.flatIndex(nb[0], nb[1], nb[2]);
+            return ctx.openVolume[std::size_t(o)] > 0.0 ? o : -1;
+          };
+          const std::int64_t lo = neighbour(-1), hi = neighbour(1);
+          const double fLo = lo >= 0 ? moment_[std::size_t(lo)] : moment_[c];
+          const double fHi = hi >= 0 ? moment_[std::size_t(hi)] : moment_[c];
+          const double span = double((lo >= 0) + (hi >= 0)) * h;
+          if (span > 0.0) g = (fHi - fLo) / span / alpha_[c];
+        }
+        drift_[3 * c + std::size_t(d)] = float(std::clamp(time_ * g, -cap_, cap_));
+      }
+    }
+  }
+
+  double time_, cap_;
+  bool owner_ = false;
+  std::size_t tracers_ = 0;
+  std::vector<float> fluctuation_[3];  ///< per tracer index: u' [m/s]
+  std::vector<float> sigma_;           ///< per cell: sigma_x, sigma_y, sigma_z [m/s]
+  std::vector<float> drift_;           ///< per cell: T g_x, T g_y, T g_z [m/s]
+  std::vector<double> moment_, alpha_; ///< scratch: alpha_P sigma_d^2 and alpha_P per cell
+  struct PlateBox {
+    Eigen::Vector2d lo, hi;
+  };
+  std::vector<Apparatus::HalfSpace> halfSpaces_;
+  std::vector<PlateBox> plates_;
+  double margin_ = 0.0;
+};
+
+const bool registered = TracerEffectRegistry::add(
+    "langevin_velocity", {"transport", "tracer_volume_fraction"}, 13,
+    "Langevin velocity: every tracer carries an Ornstein-Uhlenbeck fluctuation with its cell's variance of the "
+    "particle velocities (needs the frames' velocity spread) and time scale rcfd.langevin_time, with the drift "
+    "that keeps tracers distributed as alpha_P^rec",
+    [](TracerContext& c) { return std::make_unique<LangevinVelocityEffect>(c); }, true);
+
+}  // namespace
+}  // namespace rcfd

@@ -1,0 +1,168 @@
+// langevin_velocity: the Ornstein-Uhlenbeck fluctuation on the frames' velocity variance. On a bed at
+// rest with a uniform variance, the tracers' fluctuation has that variance and the autocorrelation
+// exp(-dt / T) of the exact OU step; where alpha_P^rec and the variance vary across the box, the drift
+// keeps the tracers distributed as alpha_P^rec; the count is kept, results are bit-identical for 1 and
+// 2 threads and across a resume, a database without the velocity spread is refused by name, and a
+// scene without the effect allocates nothing for it.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+
+#include "TracerTestSupport.hpp"
+
+using namespace rcfd;
+using namespace rcfd::test;
+
+namespace {
+
+const std::vector<std::string> kLangevin = {"transport", "walls", "tracer_volume_fraction", "langevin_velocity"};
+
+/// A 0.1 x 0.1 x 0.02 m box of 1 cm cells at rest (u_P^rec = 0). alpha(x) and the variance per
+/// component sigma2(x) as functions of the cell centre's x in [-0.05, 0.05].
+struct RestingBox {
+  Scene scene;
+  std::shared_ptr<FieldDatabase> db;
+  template <class Alpha, class Sigma2>
+  RestingBox(std::vector<std::string> effects, double time, long tracers, Alpha alpha, Sigma2 sigma2,
+             bool withSpread = true) {
+    scene = boxScene({0.1, 0.1, 0.02}, 0.01, tracers, 0.005, std::move(effects), 0.3);
+    scene.rcfd.langevin_time = time;
+    const CartesianGrid grid = gridOf(scene);
+    db = database(scene, 400, scene.rcfd.dt, [=](int, double, FieldFrame& f) {
+      const std::size_t cells = std::size_t(grid.cellCount());
+      if (withSpread) {
+        f.up_fraction.assign(cells, 0.5f);
+        f.u_p_up.assign(3 * cells, 0.0f);
+        f.u_p_down.assign(3 * cells, 0.0f);
+        f.u_p_variance.assign(3 * cells, 0.0f);
+      }
+      for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+        const auto ijk = grid.cellIjk(c);
+        const double x = grid.cellCenter(ijk[0], ijk[1], ijk[2]).x();
+        f.alpha_p[std::size_t(c)] = float(alpha(x));
+        if (withSpread)
+          for (int d = 0; d < 3; ++d) f.u_p_variance[3 * std::size_t(c) + std::size_t(d)] = float(sigma2(x));
+      }
+    });
+  }
+};
+
+std::unique_ptr<TracerSimulation> runBox(const RestingBox& box, std::int64_t steps, int threads = 2,
+                                         std::int64_t checkpointAt = -1) {
+  omp_set_num_threads(threads);
+  const RecurrencePath path = sequentialPath(box.db->frameCount(), steps + 2);
+  const TracerRunSettings settings{5, steps, 0};
+  auto sim = std::make_unique<TracerSimulation>(box.scene, box.db, path, settings);
+  for (std::int64_t k = 0; k < steps; ++k) {
+    if (k == checkpointAt) {
+      const std::string checkpoint = tempPath("langevin-checkpoint.h5");
+      sim->saveCheckpoint(checkpoint);
+      sim = std::make_unique<TracerSimulation>(box.scene, box.db, path, settings);
+      sim->loadCheckpoint(checkpoint);
+    }
+    sim->step();
+  }
+  omp_set_num_threads(2);
+  return sim;
+}
+
+double uniformAlpha(double) { return 0.3; }
+
+}  // namespace
+
+TEST(LangevinVelocity, TheFluctuationHasTheCellsVarianceAndTheOrnsteinUhlenbeckMemory) {
+  // sigma = 0.2 m/s, T = 0.02 s, dt = 5 ms: after many T the fluctuation is stationary with variance
+  // sigma^2 per component and lag-one correlation exp(-dt / T) = 0.7788.
+  const double sigma = 0.2, time = 0.02;
+  const RestingBox box(kLangevin, time, 20000, uniformAlpha, [&](double) { return sigma * sigma; });
+  omp_set_num_threads(2);
+  const RecurrencePath path = sequentialPath(box.db->frameCount(), 102);
+  TracerSimulation sim(box.scene, box.db, path, TracerRunSettings{5, 100, 0});
+  for (int k = 0; k < 40; ++k) sim.step();  // 10 T
+  const auto& u = sim.context().streamVelocity;
+  const std::size_t n = sim.cloud().size();
+  // streamVelocity is per index; the cloud may be reordered between steps, so pair by id.
+  auto byId = [&](int d) { return sim.cloud().inIdOrder(std::vector<float>(u[d].begin(), u[d].end())); };
+  const std::vector<float> before[3] = {byId(0), byId(1), byId(2)};
+  // Tracers 5 mm or more from every wall: no reflection of their fluctuation in the step.
+  const auto& cloud = sim.cloud();
+  const auto x = cloud.inIdOrder(cloud.x), y = cloud.inIdOrder(cloud.y), z = cloud.inIdOrder(cloud.z);
+  std::vector<char> interior(n);
+  for (std::size_t i = 0; i < n; ++i)
+    interior[i] = std::abs(x[i]) < 0.045 && y[i] > 0.005 && y[i] < 0.095 && z[i] > 0.005 && z[i] < 0.015;
+  sim.step();
+  const std::vector<float> after[3] = {byId(0), byId(1), byId(2)};
+  for (int d = 0; d < 3; ++d) {
+    double mean = 0.0, var = 0.0, cov = 0.0, count = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!interior[i]) continue;
+      mean += after[d][i];
+      var += double(after[d][i]) * double(after[d][i]);
+      cov += double(after[d][i]) * double(before[d][i]);
+      count += 1.0;
+    }
+    ASSERT_GT(count, 0.3 * double(n));
+    mean /= count;
+    var = var / count - mean * mean;
+    cov /= count;
+    EXPECT_NEAR(mean, 0.0, 4.0 * sigma / std::sqrt(count)) << d;
+    EXPECT_NEAR(var, sigma * sigma, 0.04 * sigma * sigma) << d;
+    EXPECT_NEAR(cov / var, std::exp(-0.005 / time), 0.02) << d;
+  }
+}
+
+TEST(LangevinVelocity, TheDriftKeepsTracersDistributedAsAlphaRecWhereAlphaAndTheVarianceVary) {
+  // alpha from 0.1 to 0.5 across x and a variance 25 times larger on the dilute side: without the
+  // drift the tracers would gather where they move least. After 2 s (about 10 diffusion times
+  // across a cell at sigma^2 T = 1e-3 m2/s on the fast side) each column of cells still holds
+  // its share of the tracers.
+  auto alpha = [](double x) { return 0.3 - 4.0 * x; };
+  auto sigma2 = [](double x) { return std::pow(0.05 + 0.2 * (0.5 - 10.0 * x), 2); };
+  const RestingBox box(kLangevin, 0.02, 40000, alpha, sigma2);
+  const auto sim = runBox(box, 400);
+  const auto& ctx = sim->context();
+  std::vector<double> column(10, 0.0), expected(10, 0.0);
+  for (std::size_t i = 0; i < sim->cloud().size(); ++i) {
+    const int k = std::clamp(int((sim->cloud().x[i] + 0.05) / 0.01), 0, 9);
+    column[std::size_t(k)] += 1.0;
+  }
+  double total = 0.0;
+  for (int k = 0; k < 10; ++k) total += expected[std::size_t(k)] = alpha(-0.045 + 0.01 * k);
+  for (int k = 0; k < 10; ++k) {
+    const double share = column[std::size_t(k)] / double(sim->cloud().size());
+    const double want = expected[std::size_t(k)] / total;
+    EXPECT_NEAR(share, want, 0.15 * want) << "column " << k;
+  }
+  EXPECT_EQ(sim->cloud().size(), std::size_t(40000));
+  EXPECT_EQ(ctx.streamVelocity[0].size(), std::size_t(40000));
+}
+
+TEST(LangevinVelocity, BitIdenticalForOneAndTwoThreadsAndAcrossAResume) {
+  const RestingBox box(kLangevin, 0.02, 20000, uniformAlpha, [](double x) { return 0.01 + x * x * 10.0; });
+  const auto two = runBox(box, 60, 2);
+  const auto one = runBox(box, 60, 1);
+  const auto resumed = runBox(box, 60, 2, 23);
+  EXPECT_EQ(two->cloud().x, one->cloud().x);
+  EXPECT_EQ(two->cloud().y, one->cloud().y);
+  EXPECT_EQ(two->cloud().x, resumed->cloud().x);
+  EXPECT_EQ(two->cloud().z, resumed->cloud().z);
+}
+
+TEST(LangevinVelocity, RefusesADatabaseWithoutTheVelocitySpreadAndAllocatesOnlyWhenListed) {
+  const RestingBox bare(kLangevin, 0.02, 2000, uniformAlpha, [](double) { return 0.01; }, false);
+  try {
+    runBox(bare, 1);
+    FAIL() << "a database without /frames/u_p_variance was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("u_p_variance"), std::string::npos) << e.what();
+  }
+  const RestingBox with(kLangevin, 0.02, 2000, uniformAlpha, [](double) { return 0.01; });
+  const auto listed = runBox(with, 1);
+  EXPECT_GT(listed->allocatedBytes("langevin_velocity"), 2000 * 3 * sizeof(float));
+  const RestingBox without({"transport", "walls", "tracer_volume_fraction"}, 0.02, 2000, uniformAlpha,
+                           [](double) { return 0.01; });
+  const auto plain = runBox(without, 1);
+  EXPECT_EQ(plain->allocatedBytes("langevin_velocity"), 0u);
+  EXPECT_TRUE(plain->context().streamVelocity[0].empty());
+}
