@@ -3,12 +3,17 @@
 #   mean     Eq. (9) with Eq. (10)'s random-walk relaxation (`fluctuation`)
 #   streams  the same with velocity_streams added after transport (the two-stream velocity)
 #   relax    Eq. (9) with directed_relaxation (the directed flux down the excess gradient)
+#   langevin the relax model with langevin_velocity (the velocity spread as an Ornstein-Uhlenbeck
+#            fluctuation)
 # Shared by scripts/regimes.sh and scripts/calibration-convergence.sh.
 def relaxation($name): map(if . == "fluctuation" or . == "directed_relaxation" then $name else . end);
-def withoutStreams: map(select(. != "velocity_streams"));
+def withoutStreams: map(select(. != "velocity_streams" and . != "langevin_velocity"));
 if $model == "mean" then {effects: (.effects | withoutStreams | relaxation("fluctuation"))}
 elif $model == "streams" then
   {effects: (.effects | withoutStreams | relaxation("fluctuation")
              | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}
 elif $model == "relax" then {effects: (.effects | withoutStreams | relaxation("directed_relaxation"))}
-else error("unknown model \($model): mean, streams or relax") end
+elif $model == "langevin" then
+  {effects: (.effects | withoutStreams | relaxation("directed_relaxation")
+             | (.[0:index("directed_relaxation") + 1] + ["langevin_velocity"] + .[index("directed_relaxation") + 1:]))}
+else error("unknown model \($model): mean, streams, relax or langevin") end

@@ -130,7 +130,7 @@ struct RcfdSpec {
   double d0 = 5e-4;                 ///< D0 of Eq. (10) [m2/s]
   double u_fluc_max = 1.0;          ///< cap of |u_fluc| [m/s]
   double free_flight_alpha = 0.02;  ///< free flight where alpha_P^rec is below this [-]
-  double langevin_time = 0.02;      ///< time scale T of langevin_velocity [s]
+  double langevin_time = 0.3;       ///< longest memory T of langevin_velocity (the dilute limit) [s]
   std::string fluctuation_model = "lichtenegger_pirker";  ///< or "cfdem"
   double max_courant = 1.0;         ///< particle Courant number bound for sub-stepping [-]
   std::string integrator = "midpoint";  ///< Eq. (9) time integration: "midpoint" (2nd order) or "euler"

@@ -1,6 +1,7 @@
 // langevin_velocity: the Ornstein-Uhlenbeck fluctuation on the frames' velocity variance. On a bed at
 // rest with a uniform variance, the tracers' fluctuation has that variance and the autocorrelation
-// exp(-dt / T) of the exact OU step; where alpha_P^rec and the variance vary across the box, the drift
+// exp(-dt / T) of the exact OU step, T the kinetic-theory time between collisions in a dense bed and
+// rcfd.langevin_time in a dilute one; where alpha_P^rec and the variance vary across the box, the drift
 // keeps the tracers distributed as alpha_P^rec; the count is kept, results are bit-identical for 1 and
 // 2 threads and across a resume, a database without the velocity spread is refused by name, and a
 // scene without the effect allocates nothing for it.
@@ -8,6 +9,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "TracerTestSupport.hpp"
 
@@ -71,11 +73,9 @@ double uniformAlpha(double) { return 0.3; }
 
 }  // namespace
 
-TEST(LangevinVelocity, TheFluctuationHasTheCellsVarianceAndTheOrnsteinUhlenbeckMemory) {
-  // sigma = 0.2 m/s, T = 0.02 s, dt = 5 ms: after many T the fluctuation is stationary with variance
-  // sigma^2 per component and lag-one correlation exp(-dt / T) = 0.7788.
-  const double sigma = 0.2, time = 0.02;
-  const RestingBox box(kLangevin, time, 20000, uniformAlpha, [&](double) { return sigma * sigma; });
+/// Variance and lag-one correlation of the fluctuation on a bed at rest of uniform alpha_P and variance.
+static void expectOrnsteinUhlenbeck(double alpha, double sigma, double memory, double expectedTime) {
+  const RestingBox box(kLangevin, memory, 20000, [=](double) { return alpha; }, [&](double) { return sigma * sigma; });
   omp_set_num_threads(2);
   const RecurrencePath path = sequentialPath(box.db->frameCount(), 102);
   TracerSimulation sim(box.scene, box.db, path, TracerRunSettings{5, 100, 0});
@@ -108,16 +108,27 @@ TEST(LangevinVelocity, TheFluctuationHasTheCellsVarianceAndTheOrnsteinUhlenbeckM
     cov /= count;
     EXPECT_NEAR(mean, 0.0, 4.0 * sigma / std::sqrt(count)) << d;
     EXPECT_NEAR(var, sigma * sigma, 0.04 * sigma * sigma) << d;
-    EXPECT_NEAR(cov / var, std::exp(-0.005 / time), 0.02) << d;
+    EXPECT_NEAR(cov / var, std::exp(-0.005 / expectedTime), 0.02) << d;
   }
 }
 
+TEST(LangevinVelocity, TheFluctuationHasTheCellsVarianceAndTheOrnsteinUhlenbeckMemory) {
+  // dt = 5 ms, sigma = 0.2 m/s. Dilute (alpha_P = 1e-3: a collision every 0.7 s): the memory is
+  // rcfd.langevin_time, 0.02 s, and the lag-one correlation exp(-dt / T) = 0.7788.
+  expectOrnsteinUhlenbeck(1e-3, 0.2, 0.02, 0.02);
+  // Dense (alpha_P = 0.05, d_P = 1.8 mm): the time between collisions d sqrt(pi) / (24 alpha g0 sigma),
+  // g0 = (1 - alpha/2) / (1 - alpha)^3 = 1.137, is 11.7 ms, below the 0.3 s cap.
+  const double alpha = 0.05, g0 = (1.0 - 0.5 * alpha) / std::pow(1.0 - alpha, 3);
+  const double collisions = 1.8e-3 * std::sqrt(std::numbers::pi) / (24.0 * alpha * g0 * 0.2);
+  EXPECT_NEAR(collisions, 0.0117, 0.0001);
+  expectOrnsteinUhlenbeck(alpha, 0.2, 0.3, collisions);
+}
+
 TEST(LangevinVelocity, TheDriftKeepsTracersDistributedAsAlphaRecWhereAlphaAndTheVarianceVary) {
-  // alpha from 0.1 to 0.5 across x and a variance 25 times larger on the dilute side: without the
-  // drift the tracers would gather where they move least. After 2 s (about 10 diffusion times
-  // across a cell at sigma^2 T = 1e-3 m2/s on the fast side) each column of cells still holds
-  // its share of the tracers.
-  auto alpha = [](double x) { return 0.3 - 4.0 * x; };
+  // alpha from 0.05 to 0.01 across x and a variance 16 times larger on the dense side: without the
+  // drift the tracers would gather where they move least. After 2 s (several diffusion times across
+  // a cell at sigma^2 T of up to 6e-4 m2/s) each column of cells still holds its share of the tracers.
+  auto alpha = [](double x) { return 0.03 - 0.4 * x; };
   auto sigma2 = [](double x) { return std::pow(0.05 + 0.2 * (0.5 - 10.0 * x), 2); };
   const RestingBox box(kLangevin, 0.02, 40000, alpha, sigma2);
   const auto sim = runBox(box, 400);
@@ -139,7 +150,7 @@ TEST(LangevinVelocity, TheDriftKeepsTracersDistributedAsAlphaRecWhereAlphaAndThe
 }
 
 TEST(LangevinVelocity, BitIdenticalForOneAndTwoThreadsAndAcrossAResume) {
-  const RestingBox box(kLangevin, 0.02, 20000, uniformAlpha, [](double x) { return 0.01 + x * x * 10.0; });
+  const RestingBox box(kLangevin, 0.02, 20000, [](double) { return 0.02; }, [](double x) { return 0.01 + x * x * 10.0; });
   const auto two = runBox(box, 60, 2);
   const auto one = runBox(box, 60, 1);
   const auto resumed = runBox(box, 60, 2, 23);

@@ -46,6 +46,8 @@ class LangevinVelocityEffect final : public TracerEffect {
     margin_ = 2.0 * ctx.apparatus.boundaryTolerance();
     const std::int64_t cells = ctx.grid.cellCount();
     sigma_.assign(3 * std::size_t(cells), 0.0f);
+    memory_.assign(std::size_t(cells), float(time_));
+    diameter_ = ctx.scene.particles.diameter;
     drift_.assign(3 * std::size_t(cells), 0.0f);
     moment_.assign(std::size_t(cells), 0.0);
     alpha_.assign(std::size_t(cells), 0.0);
@@ -64,8 +66,6 @@ class LangevinVelocityEffect final : public TracerEffect {
                      (ctx.database ? ctx.database->path() : std::string("the frames")) + " does not hold");
     cellFields(ctx);
     const std::size_t n = ctx.cloud.size();
-    const double decay = std::exp(-ctx.dt / time_);
-    const double kick = std::sqrt(std::max(0.0, 1.0 - decay * decay));
     const CounterRngPrefix prefix(ctx.seed, RngPurpose::Langevin, std::uint64_t(ctx.step));
     const std::int32_t* id = ctx.cloud.id.data();
     const TrilinearLocator::Constants locator = TrilinearLocator(ctx.grid).constants();
@@ -76,7 +76,8 @@ class LangevinVelocityEffect final : public TracerEffect {
     float* u[3] = {fluctuation_[0].data(), fluctuation_[1].data(), fluctuation_[2].data()};
     const float* sigma = sigma_.data();
     const float* drift = drift_.data();
-    const double relax = 1.0 - decay;
+    const float* memory = memory_.data();
+    const double dt = ctx.dt, cap = cap_;
     const bool owner = owner_;
 #pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
     for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
@@ -84,10 +85,11 @@ class LangevinVelocityEffect final : public TracerEffect {
       // gradient within a cell then keeps the tracers' density there as alpha_P^rec varies.
       double f[3];
       const std::size_t base = std::size_t(locator.locate(position[0][i], position[1][i], position[2][i], f[0], f[1], f[2]));
-      double sigmaAt[3] = {0.0, 0.0, 0.0}, driftAt[3] = {0.0, 0.0, 0.0};
+      double sigmaAt[3] = {0.0, 0.0, 0.0}, driftAt[3] = {0.0, 0.0, 0.0}, timeAt = 0.0;
       for (int k = 0; k < 8; ++k) {
         const double w = ((k & 1) ? f[0] : 1.0 - f[0]) * ((k & 2) ? f[1] : 1.0 - f[1]) * ((k & 4) ? f[2] : 1.0 - f[2]);
         const std::size_t c = base + std::size_t(corner[k]);
+        timeAt += w * double(memory[c]);
         for (int d = 0; d < 3; ++d) {
           sigmaAt[d] += w * double(sigma[3 * c + std::size_t(d)]);
           driftAt[d] += w * double(drift[3 * c + std::size_t(d)]);
@@ -100,8 +102,13 @@ class LangevinVelocityEffect final : public TracerEffect {
         const double phi = 2.0 * std::numbers::pi * rng.uniform();
         xi[2 * k] = r * std::cos(phi), xi[2 * k + 1] = r * std::sin(phi);
       }
+      const double decay = std::exp(-dt / timeAt);
+      const double kick = std::sqrt(std::max(0.0, 1.0 - decay * decay));
       Eigen::Vector3d next;
-      for (int d = 0; d < 3; ++d) next[d] = decay * double(u[d][i]) + relax * driftAt[d] + sigmaAt[d] * kick * xi[d];
+      for (int d = 0; d < 3; ++d) {
+        const double drift = std::clamp(timeAt * driftAt[d], -cap, cap);
+        next[d] = decay * double(u[d][i]) + (1.0 - decay) * drift + sigmaAt[d] * kick * xi[d];
+      }
       reflectAtWalls(ctx.apparatus, Eigen::Vector3d(position[0][i], position[1][i], position[2][i]), ctx.dt, next);
       for (int d = 0; d < 3; ++d) {
         u[d][i] = float(next[d]);
@@ -185,8 +192,19 @@ class LangevinVelocityEffect final : public TracerEffect {
           const double span = double((lo >= 0) + (hi >= 0)) * h;
           if (span > 0.0) g = (fHi - fLo) / span / alpha_[c];
         }
-        drift_[3 * c + std::size_t(d)] = float(std::clamp(time_ * g, -cap_, cap_));
+        drift_[3 * c + std::size_t(d)] = float(g);
       }
+    }
+    // The memory: the time between collisions of kinetic theory, d sqrt(pi) / (24 alpha_P g0 sqrt(theta))
+    // with the Carnahan-Starling g0 and theta the mean of the three variances, at most rcfd.langevin_time
+    // (the dilute limit, where drag and walls end the memory).
+    for (std::size_t c = 0; c < cells; ++c) {
+      const double a = std::min(alpha_[c], 0.6);
+      const double theta = (double(sigma_[3 * c]) * sigma_[3 * c] + double(sigma_[3 * c + 1]) * sigma_[3 * c + 1] +
+                            double(sigma_[3 * c + 2]) * sigma_[3 * c + 2]) / 3.0;
+      const double g0 = (1.0 - 0.5 * a) / std::pow(1.0 - a, 3);
+      const double rate = 24.0 * a * g0 * std::sqrt(theta) / (diameter_ * std::sqrt(std::numbers::pi));
+      memory_[c] = float(rate * time_ > 1.0 ? 1.0 / rate : time_);
     }
   }
 
@@ -195,7 +213,9 @@ class LangevinVelocityEffect final : public TracerEffect {
   std::size_t tracers_ = 0;
   std::vector<float> fluctuation_[3];  ///< per tracer index: u' [m/s]
   std::vector<float> sigma_;           ///< per cell: sigma_x, sigma_y, sigma_z [m/s]
-  std::vector<float> drift_;           ///< per cell: T g_x, T g_y, T g_z [m/s]
+  std::vector<float> drift_;           ///< per cell: g_x, g_y, g_z [m/s2]
+  std::vector<float> memory_;          ///< per cell: the time scale T [s]
+  double diameter_ = 0.0;              ///< d_P [m]
   std::vector<double> moment_, alpha_; ///< scratch: alpha_P sigma_d^2 and alpha_P per cell
   struct PlateBox {
     Eigen::Vector2d lo, hi;
