@@ -78,7 +78,7 @@ TEST(Cli, ListEffectsPrintsTheVocabulary) {
   if (!haveBinary()) GTEST_SKIP() << "rcfd-solve not built";
   const Outcome o = run("list-effects");
   EXPECT_EQ(o.exitCode, 0);
-  for (const char* name : {"gas", "transport", "fluctuation", "directed_relaxation", "free_flight", "velocity_streams", "deposition", "coverage",
+  for (const char* name : {"gas", "transport", "fluctuation", "directed_relaxation", "langevin_velocity", "free_flight", "velocity_streams", "deposition", "coverage",
                            "deposition_maps"}) {
     EXPECT_NE(o.out.find(std::string("\n  ") + name + " "), std::string::npos) << name;
   }
@@ -86,7 +86,7 @@ TEST(Cli, ListEffectsPrintsTheVocabulary) {
   EXPECT_NE(o.out.find("rcfd.fluctuation_model: lichtenegger_pirker | cfdem"), std::string::npos) << o.out;
   const Outcome j = run("list-effects --json");
   const auto list = nlohmann::json::parse(j.out);
-  ASSERT_EQ(list["effects"].size(), 18u);
+  ASSERT_EQ(list["effects"].size(), 19u);
   EXPECT_EQ(list["effects"][0]["name"], "gas");
   EXPECT_EQ(list["effects"][0]["stage"], "cfd_dem");
   bool apparatus = false;
