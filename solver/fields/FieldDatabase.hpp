@@ -60,6 +60,9 @@ struct FrameStorage {
   /// Also read the velocity spread (kVelocitySpreadFields); an input error naming the dataset when the
   /// file has none. Off: those datasets are not read and cost no memory.
   bool velocitySpread = false;
+  /// With velocitySpread: a file that holds none of it is opened without it (the readers that use it
+  /// when present do without it) instead of refused.
+  bool velocitySpreadIfPresent = false;
 };
 
 struct FrameCacheStats {

@@ -287,7 +287,9 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   reader->uP = openFloatDataset(reader->file, layout::uP, vec, v, &nP);
   reader->uG = openFloatDataset(reader->file, layout::uG, vec, v, &nG);
   hsize_t n = std::min({nA, nP, nG});
-  if (storage.velocitySpread) {
+  const bool noSpread = std::none_of(std::begin(kVelocitySpreadFields), std::end(kVelocitySpreadFields),
+                                     [&](const OptionalFrameField& f) { return hdf5::linkExists(reader->file, f.path); });
+  if (storage.velocitySpread && !(storage.velocitySpreadIfPresent && noSpread)) {
     for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
       const auto& f = kVelocitySpreadFields[k];
       if (!hdf5::linkExists(reader->file, f.path)) {

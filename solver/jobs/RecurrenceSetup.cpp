@@ -23,7 +23,8 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
       setup.matrixWasStored = true;
     }
   }
-  const FrameStorage storage{scene.rcfd.frame_cache_bytes, TracerEffectRegistry::needsVelocitySpread(scene.effects)};
+  const FrameStorage storage{scene.rcfd.frame_cache_bytes, TracerEffectRegistry::needsVelocitySpread(scene.effects),
+                             !TracerEffectRegistry::requiresVelocitySpread(scene.effects)};
   setup.database = FieldDatabase::open(databasePath, storage);
   if (!setup.matrixWasStored) {
     setup.matrix = computeRecurrenceMatrix(*setup.database);

@@ -19,9 +19,10 @@ std::string validNames() {
 }  // namespace
 
 bool TracerEffectRegistry::add(const std::string& name, std::vector<std::string> needs, int order,
-                               std::string doc, Factory factory, bool readsVelocitySpread) {
-  auto [it, inserted] = table().emplace(
-      name, Entry{std::move(doc), std::move(needs), order, std::move(factory), readsVelocitySpread});
+                               std::string doc, Factory factory, bool readsVelocitySpread,
+                               bool velocitySpreadOptional) {
+  auto [it, inserted] = table().emplace(name, Entry{std::move(doc), std::move(needs), order, std::move(factory),
+                                                    readsVelocitySpread, velocitySpreadOptional});
   if (!inserted) throw std::logic_error("tracer effect registered twice: " + name);
   return true;
 }
@@ -64,6 +65,13 @@ bool TracerEffectRegistry::needsVelocitySpread(const std::vector<std::string>& e
   return std::any_of(effects.begin(), effects.end(), [](const std::string& name) {
     const auto it = table().find(name);
     return it != table().end() && it->second.readsVelocitySpread;
+  });
+}
+
+bool TracerEffectRegistry::requiresVelocitySpread(const std::vector<std::string>& effects) {
+  return std::any_of(effects.begin(), effects.end(), [](const std::string& name) {
+    const auto it = table().find(name);
+    return it != table().end() && it->second.readsVelocitySpread && !it->second.velocitySpreadOptional;
   });
 }
 

@@ -76,10 +76,11 @@ class TracerEffectRegistry {
     int order = 0;  ///< position in the step among independent effects (lower first)
     Factory factory;
     bool readsVelocitySpread = false;  ///< reads the frames' velocity spread (FrameStorage::velocitySpread)
+    bool velocitySpreadOptional = false;  ///< does without it (and says so) when the database has none
   };
 
   static bool add(const std::string& name, std::vector<std::string> needs, int order, std::string doc,
-                  Factory factory, bool readsVelocitySpread = false);
+                  Factory factory, bool readsVelocitySpread = false, bool velocitySpreadOptional = false);
   static const std::map<std::string, Entry>& entries();
   static bool contains(const std::string& name);
 
@@ -89,6 +90,8 @@ class TracerEffectRegistry {
   /// Whether any of the listed effects reads the frames' velocity spread: the database is then opened
   /// with it (and without it otherwise, so that it costs no memory).
   static bool needsVelocitySpread(const std::vector<std::string>& effects);
+  /// Whether one of them cannot do without it (the database is then refused when it has none).
+  static bool requiresVelocitySpread(const std::vector<std::string>& effects);
 };
 
 /// Effect names of the other stages (CFD-DEM, spray) that a tracer run ignores.

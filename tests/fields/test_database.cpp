@@ -408,6 +408,9 @@ TEST(FieldDatabase, TheVelocitySpreadIsReadOnlyWhenAskedFor) {
     EXPECT_EQ(e.violations().size(), 4u);
     EXPECT_EQ(e.violations()[0].pointer, "/frames/up_fraction");
   }
+  // Asked for it only if present: opened without it; a file that has it is read with it.
+  EXPECT_FALSE(FieldDatabase::open(plain, FrameStorage{0, true, true})->hasVelocitySpread());
+  EXPECT_TRUE(FieldDatabase::open(path, FrameStorage{0, true, true})->hasVelocitySpread());
   // Reopened for appending, the writer goes on with the spread and keeps the frames' datasets aligned.
   {
     auto w = FieldDatabaseWriter::reopen(path, g, 3);

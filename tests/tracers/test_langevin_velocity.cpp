@@ -160,14 +160,28 @@ TEST(LangevinVelocity, BitIdenticalForOneAndTwoThreadsAndAcrossAResume) {
   EXPECT_EQ(two->cloud().z, resumed->cloud().z);
 }
 
-TEST(LangevinVelocity, RefusesADatabaseWithoutTheVelocitySpreadAndAllocatesOnlyWhenListed) {
-  const RestingBox bare(kLangevin, 0.02, 2000, uniformAlpha, [](double) { return 0.01; }, false);
-  try {
-    runBox(bare, 1);
-    FAIL() << "a database without /frames/u_p_variance was accepted";
-  } catch (const std::exception& e) {
-    EXPECT_NE(std::string(e.what()).find("u_p_variance"), std::string::npos) << e.what();
-  }
+TEST(LangevinVelocity, WithoutTheVelocitySpreadTracersMoveAsWithoutItAndTheSummarySaysSo) {
+  // A moving bed (u_P^rec = 0.1 m/s along x) of a database without the spread.
+  auto flowing = [](std::vector<std::string> effects) {
+    RestingBox box(std::move(effects), 0.02, 4000, uniformAlpha, [](double) { return 0.01; }, false);
+    const CartesianGrid grid = gridOf(box.scene);
+    box.db = database(box.scene, 40, box.scene.rcfd.dt, [=](int, double, FieldFrame& f) {
+      std::fill(f.alpha_p.begin(), f.alpha_p.end(), 0.3f);
+      for (std::int64_t c = 0; c < grid.cellCount(); ++c) f.u_p[3 * std::size_t(c)] = 0.1f;
+    });
+    return box;
+  };
+  const auto listed = runBox(flowing(kLangevin), 30);
+  const auto plain = runBox(flowing({"transport", "walls", "tracer_volume_fraction"}), 30);
+  EXPECT_EQ(listed->cloud().inIdOrder(listed->cloud().x), plain->cloud().inIdOrder(plain->cloud().x));
+  h5::File out(tempPath("langevin-result.h5"), h5::File::Mode::Create);
+  nlohmann::json summary;
+  listed->writeResults(out, summary);
+  EXPECT_EQ(summary["langevin_velocity"]["active"], false);
+  EXPECT_NE(summary["langevin_velocity"]["note"].get<std::string>().find("u_p_variance"), std::string::npos);
+}
+
+TEST(LangevinVelocity, AllocatesOnlyWhenListed) {
   const RestingBox with(kLangevin, 0.02, 2000, uniformAlpha, [](double) { return 0.01; });
   const auto listed = runBox(with, 1);
   EXPECT_GT(listed->allocatedBytes("langevin_velocity"), 2000 * 3 * sizeof(float));

@@ -18,6 +18,8 @@
 #include <memory>
 #include <numbers>
 
+#include <spdlog/spdlog.h>
+
 #include "core/Errors.hpp"
 #include "core/Permutation.hpp"
 #include "tracers/CounterRng.hpp"
@@ -60,10 +62,20 @@ class LangevinVelocityEffect final : public TracerEffect {
   }
 
   void beforeMove(TracerContext& ctx) override {
-    const FieldFrame& a = *ctx.frame;
-    if (!a.hasVelocitySpread())
-      throw RunError("langevin_velocity needs the frames' velocity spread (/frames/u_p_variance), which " +
-                     (ctx.database ? ctx.database->path() : std::string("the frames")) + " does not hold");
+    if (!ctx.frame->hasVelocitySpread()) {
+      // A database without the spread (from elsewhere, or written for a scene without the effect):
+      // the tracers move without the fluctuation, and the log and summary say so.
+      if (!missingSpread_) {
+        missingSpread_ = true;
+        spdlog::warn("langevin_velocity: {} holds no velocity spread (/frames/u_p_variance); the tracers move "
+                     "without the Langevin fluctuation",
+                     ctx.database ? ctx.database->path() : std::string("the database"));
+      }
+      if (owner_) {
+        for (auto& v : ctx.streamVelocity) std::fill(v.begin(), v.end(), 0.0f);
+      }
+      return;
+    }
     cellFields(ctx);
     const std::size_t n = ctx.cloud.size();
     const CounterRngPrefix prefix(ctx.seed, RngPurpose::Langevin, std::uint64_t(ctx.step));
@@ -115,6 +127,14 @@ class LangevinVelocityEffect final : public TracerEffect {
         out[d][i] = owner ? float(next[d]) : out[d][i] + float(next[d]);
       }
     }
+  }
+
+  void writeResults(const TracerContext&, h5::File&, nlohmann::json& summary) const override {
+    summary["langevin_velocity"] = {
+        {"active", !missingSpread_},
+        {"note", missingSpread_ ? "the database holds no velocity spread (/frames/u_p_variance): the tracers moved "
+                                  "without the Langevin fluctuation"
+                                : "Ornstein-Uhlenbeck fluctuation on the frames' velocity variance"}};
   }
 
   void permuteTracers(TracerContext&, const std::vector<std::int32_t>& from) override {
@@ -210,6 +230,7 @@ class LangevinVelocityEffect final : public TracerEffect {
 
   double time_, cap_;
   bool owner_ = false;
+  bool missingSpread_ = false;
   std::size_t tracers_ = 0;
   std::vector<float> fluctuation_[3];  ///< per tracer index: u' [m/s]
   std::vector<float> sigma_;           ///< per cell: sigma_x, sigma_y, sigma_z [m/s]
@@ -230,7 +251,7 @@ const bool registered = TracerEffectRegistry::add(
     "Langevin velocity: every tracer carries an Ornstein-Uhlenbeck fluctuation with its cell's variance of the "
     "particle velocities (needs the frames' velocity spread) and time scale rcfd.langevin_time, with the drift "
     "that keeps tracers distributed as alpha_P^rec",
-    [](TracerContext& c) { return std::make_unique<LangevinVelocityEffect>(c); }, true);
+    [](TracerContext& c) { return std::make_unique<LangevinVelocityEffect>(c); }, true, true);
 
 }  // namespace
 }  // namespace rcfd
