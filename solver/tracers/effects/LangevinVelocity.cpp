@@ -6,13 +6,14 @@
 // Every tracer carries a fluctuation u' (per component d, variance sigma_d^2 of its cell in the step's
 // frame), integrated exactly over the step for constant coefficients:
 //   u'_d <- a u'_d + (1 - a) T g_d + sigma_d sqrt(1 - a^2) xi,   a = exp(-dt / T),
-// with T = rcfd.langevin_time, xi standard normal (a counter-based stream per tracer and step), and the
-// drift g_d = d(alpha_P sigma_d^2)/dx_d / alpha_P: in the diffusive limit the tracer flux is then
+// with T the kinetic-theory time between collisions (at most rcfd.langevin_time), xi standard normal
+// (NormalTable, from a counter-based stream per tracer and step), and the drift g_d = d(alpha_P sigma_d^2)/dx_d / alpha_P: in the diffusive limit the tracer flux is then
 // -T grad(sigma^2 n) + n T g, which vanishes for n proportional to alpha_P^rec, so the fluctuation
 // does not move tracers out of where the recurrence field puts them (the well-mixed condition of
 // Thomson 1987, in its mean-drift form). |T g| is capped at rcfd.u_fluc_max. u' is added to Eq. (9)
 // over the step (TracerContext::streamVelocity, after velocity_streams and directed_relaxation when
-// those are listed).
+// those are listed). The step's coefficients a, sigma_d sqrt(1 - a^2) and (1 - a) T g_d are computed per
+// cell and interpolated trilinearly to the tracer.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "core/Errors.hpp"
 #include "core/Permutation.hpp"
 #include "tracers/CounterRng.hpp"
+#include "tracers/NormalTable.hpp"
 #include "tracers/TracerEffect.hpp"
 #include "tracers/Trilinear.hpp"
 
@@ -48,7 +50,7 @@ class LangevinVelocityEffect final : public TracerEffect {
     margin_ = 2.0 * ctx.apparatus.boundaryTolerance();
     const std::int64_t cells = ctx.grid.cellCount();
     sigma_.assign(3 * std::size_t(cells), 0.0f);
-    memory_.assign(std::size_t(cells), float(time_));
+    coefficients_.assign(kCoefficients * std::size_t(cells), 0.0f);
     diameter_ = ctx.scene.particles.diameter;
     drift_.assign(3 * std::size_t(cells), 0.0f);
     moment_.assign(std::size_t(cells), 0.0);
@@ -57,7 +59,7 @@ class LangevinVelocityEffect final : public TracerEffect {
 
   std::size_t allocatedBytes() const override {
     return (owner_ ? 3 * tracers_ * sizeof(float) : 0) + 3 * tracers_ * sizeof(float) +
-           (sigma_.capacity() + drift_.capacity()) * sizeof(float) +
+           (sigma_.capacity() + drift_.capacity() + coefficients_.capacity()) * sizeof(float) +
            (moment_.capacity() + alpha_.capacity()) * sizeof(double);
   }
 
@@ -86,41 +88,26 @@ class LangevinVelocityEffect final : public TracerEffect {
     const double* position[3] = {ctx.cloud.x.data(), ctx.cloud.y.data(), ctx.cloud.z.data()};
     float* out[3] = {ctx.streamVelocity[0].data(), ctx.streamVelocity[1].data(), ctx.streamVelocity[2].data()};
     float* u[3] = {fluctuation_[0].data(), fluctuation_[1].data(), fluctuation_[2].data()};
-    const float* sigma = sigma_.data();
-    const float* drift = drift_.data();
-    const float* memory = memory_.data();
-    const double dt = ctx.dt, cap = cap_;
+    const float* coefficients = coefficients_.data();
+    const NormalTable& normals = NormalTable::instance();
     const bool owner = owner_;
 #pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
     for (std::int64_t i = 0; i < std::int64_t(n); ++i) {
-      // sigma and the drift at the tracer's position, trilinear between cell centres: the drift's
+      // The step's coefficients at the tracer's position, trilinear between cell centres: the drift's
       // gradient within a cell then keeps the tracers' density there as alpha_P^rec varies.
       double f[3];
       const std::size_t base = std::size_t(locator.locate(position[0][i], position[1][i], position[2][i], f[0], f[1], f[2]));
-      double sigmaAt[3] = {0.0, 0.0, 0.0}, driftAt[3] = {0.0, 0.0, 0.0}, timeAt = 0.0;
+      double at[kCoefficients] = {};
       for (int k = 0; k < 8; ++k) {
         const double w = ((k & 1) ? f[0] : 1.0 - f[0]) * ((k & 2) ? f[1] : 1.0 - f[1]) * ((k & 4) ? f[2] : 1.0 - f[2]);
-        const std::size_t c = base + std::size_t(corner[k]);
-        timeAt += w * double(memory[c]);
-        for (int d = 0; d < 3; ++d) {
-          sigmaAt[d] += w * double(sigma[3 * c + std::size_t(d)]);
-          driftAt[d] += w * double(drift[3 * c + std::size_t(d)]);
-        }
+        const float* cell = coefficients + kCoefficients * (base + std::size_t(corner[k]));
+        for (int q = 0; q < kCoefficients; ++q) at[q] += w * double(cell[q]);
       }
+      double xi[3];
       CounterRng rng(prefix, std::uint64_t(id[i]));
-      double xi[4];
-      for (int k = 0; k < 2; ++k) {  // Box-Muller: two pairs of standard normals
-        const double r = std::sqrt(-2.0 * std::log(1.0 - rng.uniform()));
-        const double phi = 2.0 * std::numbers::pi * rng.uniform();
-        xi[2 * k] = r * std::cos(phi), xi[2 * k + 1] = r * std::sin(phi);
-      }
-      const double decay = std::exp(-dt / timeAt);
-      const double kick = std::sqrt(std::max(0.0, 1.0 - decay * decay));
+      normals.three(rng.nextU64(), xi);
       Eigen::Vector3d next;
-      for (int d = 0; d < 3; ++d) {
-        const double drift = std::clamp(timeAt * driftAt[d], -cap, cap);
-        next[d] = decay * double(u[d][i]) + (1.0 - decay) * drift + sigmaAt[d] * kick * xi[d];
-      }
+      for (int d = 0; d < 3; ++d) next[d] = at[0] * double(u[d][i]) + at[4 + d] + at[1 + d] * xi[d];
       reflectAtWalls(ctx.apparatus, Eigen::Vector3d(position[0][i], position[1][i], position[2][i]), ctx.dt, next);
       for (int d = 0; d < 3; ++d) {
         u[d][i] = float(next[d]);
@@ -217,14 +204,22 @@ class LangevinVelocityEffect final : public TracerEffect {
     }
     // The memory: the time between collisions of kinetic theory, d sqrt(pi) / (24 alpha_P g0 sqrt(theta))
     // with the Carnahan-Starling g0 and theta the mean of the three variances, at most rcfd.langevin_time
-    // (the dilute limit, where drag and walls end the memory).
+    // (the dilute limit, where drag and walls end the memory). Then the exact OU step's coefficients.
     for (std::size_t c = 0; c < cells; ++c) {
       const double a = std::min(alpha_[c], 0.6);
       const double theta = (double(sigma_[3 * c]) * sigma_[3 * c] + double(sigma_[3 * c + 1]) * sigma_[3 * c + 1] +
                             double(sigma_[3 * c + 2]) * sigma_[3 * c + 2]) / 3.0;
       const double g0 = (1.0 - 0.5 * a) / std::pow(1.0 - a, 3);
       const double rate = 24.0 * a * g0 * std::sqrt(theta) / (diameter_ * std::sqrt(std::numbers::pi));
-      memory_[c] = float(rate * time_ > 1.0 ? 1.0 / rate : time_);
+      const double memory = rate * time_ > 1.0 ? 1.0 / rate : time_;
+      const double decay = std::exp(-ctx.dt / memory);
+      const double kick = std::sqrt(std::max(0.0, 1.0 - decay * decay));
+      float* k = coefficients_.data() + kCoefficients * c;
+      k[0] = float(decay);
+      for (int d = 0; d < 3; ++d) {
+        k[1 + d] = float(double(sigma_[3 * c + std::size_t(d)]) * kick);
+        k[4 + d] = float((1.0 - decay) * std::clamp(memory * double(drift_[3 * c + std::size_t(d)]), -cap_, cap_));
+      }
     }
   }
 
@@ -235,7 +230,10 @@ class LangevinVelocityEffect final : public TracerEffect {
   std::vector<float> fluctuation_[3];  ///< per tracer index: u' [m/s]
   std::vector<float> sigma_;           ///< per cell: sigma_x, sigma_y, sigma_z [m/s]
   std::vector<float> drift_;           ///< per cell: g_x, g_y, g_z [m/s2]
-  std::vector<float> memory_;          ///< per cell: the time scale T [s]
+  /// Per cell, the exact OU step over dt for the step's frame: a = exp(-dt / T), sigma_d sqrt(1 - a^2)
+  /// and (1 - a) T g_d (capped), padded to 8 floats.
+  static constexpr int kCoefficients = 8;
+  std::vector<float> coefficients_;
   double diameter_ = 0.0;              ///< d_P [m]
   std::vector<double> moment_, alpha_; ///< scratch: alpha_P sigma_d^2 and alpha_P per cell
   struct PlateBox {
