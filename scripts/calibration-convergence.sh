@@ -5,7 +5,7 @@
 #   bash scripts/calibration-convergence.sh SCENE.json DATABASE.h5 OUT_DIR [TRACERS ...]
 # TRACERS defaults to "20000 one-per-particle 100000"; RCFD_SEEDS to "1 2 3"; RCFD_MODEL picks the tracer
 # motion model of scripts/model-effects.jq (mean, streams: the database must carry the velocity spread,
-# relax). Resumable
+# relax, langevin: the Langevin velocity without the spread does nothing). Resumable
 # (finished calibrations are kept). Needs a build and jq.
 set -euo pipefail
 cd "$(dirname "$0")/.."

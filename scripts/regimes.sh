@@ -4,7 +4,8 @@
 # quick-draft-plates-aligned), quick-dilute-jet and quick-coarse-cells
 # (the spout on cells of 3.7 parcel diameters, several parcels per cell), the database
 # job, then a calibration per tracer motion model (scripts/model-effects.jq: "mean", Eq. (9) with
-# Eq. (10); "streams", the two-stream velocity; "relax", directed relaxation instead of Eq. (10)), a
+# Eq. (10); "streams", the two-stream velocity; "relax", directed relaxation instead of Eq. (10);
+# "langevin", relax with the Langevin velocity), a
 # spray job of each at its selected D0 with one tracer per parcel over the reference
 # period (its coverage distribution against the full simulation's), and a table of what each selects
 # and how its spray-zone stays and coverage compare.
@@ -12,7 +13,7 @@
 # Resumable: run it again with the same OUT_DIR and finished jobs are kept, interrupted ones resume
 # from their checkpoints. RCFD_REGIMES_DATABASE_JOB picks the database job variant (default
 # "database"; "database-10s" samples 10 s + 10 s where examples/jobs has it), RCFD_REGIMES_MODELS the
-# models (default "mean streams relax"). Needs a build and jq.
+# models (default "mean streams relax langevin"). Needs a build and jq.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 1 ]; then
@@ -24,7 +25,7 @@ shift
 regimes=("$@")
 [ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-draft-plates-aligned quick-dilute-jet quick-coarse-cells)
 variant=${RCFD_REGIMES_DATABASE_JOB:-database}
-read -r -a models <<< "${RCFD_REGIMES_MODELS:-mean streams relax}"
+read -r -a models <<< "${RCFD_REGIMES_MODELS:-mean streams relax langevin}"
 solve=$(pwd)/build/rcfd-solve
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 
