@@ -2,7 +2,10 @@
 // Shared set-up of the tracer tests: box scenes and analytic in-memory databases.
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <numbers>
+#include <omp.h>
+#include <string>
 
 #include "../fields/FieldTestUtil.hpp"
 #include "fields/AnalyticDatabase.hpp"
@@ -48,6 +51,28 @@ inline RecurrencePath sequentialPath(int frames, std::int64_t length) {
   p.frames.resize(std::size_t(length));
   for (std::int64_t i = 0; i < length; ++i) p.frames[std::size_t(i)] = int(i % frames);
   return p;
+}
+
+/// `steps` steps of a tracer run on `threads` threads along the sequential path; at step
+/// `checkpointAt` (when >= 0) the run is saved to `checkpointFile`, discarded and resumed from it.
+inline std::unique_ptr<TracerSimulation> runSteps(const Scene& scene, std::shared_ptr<FieldDatabase> db,
+                                                  std::uint64_t seed, std::int64_t steps, int threads,
+                                                  std::int64_t checkpointAt, const std::string& checkpointFile) {
+  omp_set_num_threads(threads);
+  const RecurrencePath path = sequentialPath(db->frameCount(), steps + 2);
+  const TracerRunSettings settings{seed, steps, 0};
+  auto sim = std::make_unique<TracerSimulation>(scene, db, path, settings);
+  for (std::int64_t k = 0; k < steps; ++k) {
+    if (k == checkpointAt) {
+      const std::string checkpoint = tempPath(checkpointFile);
+      sim->saveCheckpoint(checkpoint);
+      sim = std::make_unique<TracerSimulation>(scene, db, path, settings);
+      sim->loadCheckpoint(checkpoint);
+    }
+    sim->step();
+  }
+  omp_set_num_threads(2);
+  return sim;
 }
 
 }  // namespace rcfd::test

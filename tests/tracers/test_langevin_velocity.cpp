@@ -55,21 +55,7 @@ struct RestingBox {
 
 std::unique_ptr<TracerSimulation> runBox(const RestingBox& box, std::int64_t steps, int threads = 2,
                                          std::int64_t checkpointAt = -1) {
-  omp_set_num_threads(threads);
-  const RecurrencePath path = sequentialPath(box.db->frameCount(), steps + 2);
-  const TracerRunSettings settings{5, steps, 0};
-  auto sim = std::make_unique<TracerSimulation>(box.scene, box.db, path, settings);
-  for (std::int64_t k = 0; k < steps; ++k) {
-    if (k == checkpointAt) {
-      const std::string checkpoint = tempPath("langevin-checkpoint.h5");
-      sim->saveCheckpoint(checkpoint);
-      sim = std::make_unique<TracerSimulation>(box.scene, box.db, path, settings);
-      sim->loadCheckpoint(checkpoint);
-    }
-    sim->step();
-  }
-  omp_set_num_threads(2);
-  return sim;
+  return runSteps(box.scene, box.db, 5, steps, threads, checkpointAt, "langevin-checkpoint.h5");
 }
 
 double uniformAlpha(double) { return 0.3; }
