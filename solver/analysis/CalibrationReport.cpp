@@ -161,7 +161,6 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
       s.ksDistance = c.ksDistance;
       if (std::isfinite(c.meanError())) s.rtdMeanRelativeError = c.meanError();
       if (std::isfinite(c.crossingRateError())) s.crossingRateRelativeError = c.crossingRateError();
-      s.stays = (long long)(c.tracers.stays);
       s.staysJson = c.toJson();
     }
     if (refHoldup && refHoldupMean > 0.0) s.holdupRelativeError = (s.holdupMean - refHoldupMean) / refHoldupMean;

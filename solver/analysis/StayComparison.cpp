@@ -70,6 +70,25 @@ WeightedSample fromStepCounts(const std::vector<std::int64_t>& counts, double dt
   return out;
 }
 
+WeightedSample windowCorrected(const WeightedSample& sample, double period, double longest, double* beyond) {
+  if (beyond) *beyond = 0.0;
+  if (!(period > 0.0)) return sample;
+  WeightedSample out;
+  double total = 0.0, left = 0.0;
+  for (std::size_t i = 0; i < sample.values.size(); ++i) {
+    const double d = sample.values[i], w = sample.weights.empty() ? 1.0 : sample.weights[i];
+    total += w;
+    if (d > longest) {
+      left += w;
+      continue;
+    }
+    out.values.push_back(d);
+    out.weights.push_back(w * period / (period - d));
+  }
+  if (beyond && total > 0.0) *beyond = left / total;
+  return out;
+}
+
 StaySummary summariseStays(const WeightedSample& sample, double members, double period) {
   StaySummary s;
   std::vector<std::pair<double, double>> sorted;
@@ -99,6 +118,12 @@ double StayComparison::crossingRateError() const {
 nlohmann::json StayComparison::toJson() const {
   return {{"resolution", "reference stays put on the tracers' step lattice (docs/calibration.md)"},
           {"lattice_dt_s", latticeDt},
+          {"window", {{"correction", "each stay weighted by P / (P - d) for its side's observed period P (docs/calibration.md)"},
+                      {"tracers_s", tracerWindow},
+                      {"reference_s", referenceWindow},
+                      {"longest_compared_s", numberOrNull(longestCompared)},
+                      {"tracers_beyond_fraction", tracersBeyond},
+                      {"reference_beyond_fraction", referenceBeyond}}},
           {"tracers", analysis::toJson(tracers)},
           {"reference", analysis::toJson(reference)},
           {"reference_unseen_fraction", referenceUnseen},
@@ -112,8 +137,16 @@ StayComparison compareStays(const std::vector<std::int64_t>& tracerStepCounts, d
                             double referenceMembers, double referencePeriod) {
   StayComparison c;
   c.latticeDt = dt;
-  const WeightedSample t = fromStepCounts(tracerStepCounts, dt);
-  const WeightedSample r = onStepLattice(referenceDurations, dt, &c.referenceUnseen);
+  c.tracerWindow = std::max(0.0, tracerPeriod);
+  c.referenceWindow = std::max(0.0, referencePeriod);
+  // Both windows known: compare what both see with weights of at most 2. One unknown: no correction
+  // (the two sides' censoring cannot be matched).
+  const bool windows = c.tracerWindow > 0.0 && c.referenceWindow > 0.0;
+  c.longestCompared = windows ? 0.5 * std::min(c.tracerWindow, c.referenceWindow) : std::numeric_limits<double>::infinity();
+  const WeightedSample t = windowCorrected(fromStepCounts(tracerStepCounts, dt), windows ? c.tracerWindow : 0.0,
+                                           c.longestCompared, &c.tracersBeyond);
+  const WeightedSample r = windowCorrected(onStepLattice(referenceDurations, dt, &c.referenceUnseen),
+                                           windows ? c.referenceWindow : 0.0, c.longestCompared, &c.referenceBeyond);
   c.tracers = summariseStays(t, tracers, tracerPeriod);
   c.reference = summariseStays(r, referenceMembers, referencePeriod);
   c.ksDistance = t.empty() || r.empty() ? 1.0 : ksDistance(t, r);

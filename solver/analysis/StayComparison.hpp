@@ -12,6 +12,14 @@
 /// weighted lattice durations; the weight at k = 0 is the share of stays the lattice does not see. Both
 /// sides then count, average and rank the same observable. Exact in distribution for any d; the
 /// reference's own sampling (within one of its samples of the true duration) stays in it.
+///
+/// Both sides also see their stays through a window of finite length: a stay counts only when it begins
+/// and ends within the observed period P, which for a stationary flow happens to a share (P - d) / P of
+/// the stays of duration d. Long stays are under-counted, the more so the shorter the window, so a 2 s
+/// reference against 8 s of tracers would compare two censorings, not two motions. Each counted stay is
+/// weighted by P / (P - d) for its own side's P (Horvitz-Thompson), which estimates the stays that begin
+/// within the period whatever their end; stays longer than half the shorter window (weights above 2,
+/// and seen by that side only rarely) are left out on both sides and their share reported.
 
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -29,7 +37,7 @@ WeightedSample fromStepCounts(const std::vector<std::int64_t>& counts, double dt
 
 /// What a comparison reports of one side.
 struct StaySummary {
-  double stays = 0.0;         ///< (weighted) number of stays seen
+  double stays = 0.0;         ///< (weighted) number of stays compared
   double mean_s = 0.0;        ///< [s]
   double median_s = 0.0;      ///< [s]
   double p90_s = 0.0;         ///< [s]
@@ -38,9 +46,18 @@ struct StaySummary {
 /// Mean, median, p90 of a weighted sample and its crossing rate over `members` observed for `period` s.
 StaySummary summariseStays(const WeightedSample& sample, double members, double period);
 
+/// The stays of a sample counted through a window of `period` s, corrected for the window: each stay of
+/// duration d <= longest weighted by period / (period - d); stays above `longest` (which must be below
+/// `period`) left out, their share of the weight going to *beyond when given. Unchanged when period <= 0
+/// (unknown).
+WeightedSample windowCorrected(const WeightedSample& sample, double period, double longest, double* beyond = nullptr);
+
 /// Tracers against the reference on the tracers' lattice.
 struct StayComparison {
   double latticeDt = 0.0;
+  double tracerWindow = 0.0, referenceWindow = 0.0;  ///< observed periods [s] (0: unknown, no window correction)
+  double longestCompared = 0.0;                      ///< [s]; infinite without window correction
+  double tracersBeyond = 0.0, referenceBeyond = 0.0;  ///< share of each side's stays longer than that
   StaySummary tracers, reference;
   double ksDistance = 0.0;         ///< between the two lattice distributions
   double referenceUnseen = 0.0;    ///< share of reference stays the lattice does not see

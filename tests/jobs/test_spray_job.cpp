@@ -133,12 +133,20 @@ TEST_F(SprayJob, ComparesItsStaysWithTheDatabasesReferenceWhenThereIsOne) {
   ASSERT_TRUE(c.is_object()) << s.dump(1);
   EXPECT_DOUBLE_EQ(c["lattice_dt_s"].get<double>(), 0.005);
   EXPECT_NEAR(c["reference"]["mean_s"].get<double>(), 0.02, 1e-12);
-  EXPECT_NEAR(c["reference"]["crossings_per_member_per_s"].get<double>(), 3.0, 1e-9);
+  // 3 stays per parcel per second seen through a 1 s window: each weighted by 1 s / (1 s - 0.02 s).
+  EXPECT_NEAR(c["reference"]["crossings_per_member_per_s"].get<double>(), 3.0 / 0.98, 1e-9);
   EXPECT_EQ(c["reference_unseen_fraction"].get<double>(), 0.0);
-  EXPECT_EQ(c["tracers"]["stays"].get<double>(), s["residence_time"]["stays"].get<double>());
-  EXPECT_NEAR(c["tracers"]["mean_s"].get<double>(), s["residence_time"]["mean_s"].get<double>(), 1e-12);
-  EXPECT_NEAR(c["tracers"]["crossings_per_member_per_s"].get<double>(),
-              s["residence_time"]["crossings_per_tracer_per_s"].get<double>(), 1e-12);
+  const json& window = c["window"];
+  EXPECT_EQ(window["reference_s"].get<double>(), 1.0);
+  EXPECT_NEAR(window["longest_compared_s"].get<double>(), 0.5 * std::min(1.0, window["tracers_s"].get<double>()), 1e-12);
+  // The tracers' own stays up to the longest compared, each weighted by between 1 and 2 for their window.
+  const double rawStays = s["residence_time"]["stays"].get<double>();
+  const double compared = rawStays * (1.0 - window["tracers_beyond_fraction"].get<double>());
+  EXPECT_LT(window["tracers_beyond_fraction"].get<double>(), 0.05);
+  EXPECT_GE(c["tracers"]["stays"].get<double>(), compared - 1e-9);
+  EXPECT_LE(c["tracers"]["stays"].get<double>(), 2.0 * compared);
+  EXPECT_NEAR(c["tracers"]["crossings_per_member_per_s"].get<double>() / c["tracers"]["stays"].get<double>(),
+              s["residence_time"]["crossings_per_tracer_per_s"].get<double>() / rawStays, 1e-12);
   EXPECT_GE(c["ks_distance"].get<double>(), 0.0);
   EXPECT_LE(c["ks_distance"].get<double>(), 1.0);
 }

@@ -273,3 +273,38 @@ TEST(StayComparison, StaysSampledAtStepEndsOfARandomPhaseMatchTheProjection) {
   EXPECT_NEAR(p.mean_s / s.mean_s, 1.0, 0.005);
   EXPECT_NEAR(p.crossingRate / s.crossingRate, 1.0, 0.005);
 }
+
+TEST(StayComparison, TheWindowCorrectionComparesAShortReferenceWithALongTracerRun) {
+  // One stationary flow, observed twice: the reference for 2 s at 1 ms, the tracers for 8 s at their
+  // 5 ms steps. A third of the stays are long (0.5-1.5 s), so the 2 s window loses many more of them.
+  CounterRng rng(5, RngPurpose::Test, 0, 0);
+  const double dt = 0.005, referenceWindow = 2.0, tracerWindow = 8.0;
+  const int members = 10000;
+  std::vector<double> reference;
+  std::vector<std::int64_t> tracerCounts(400, 0);
+  for (int m = 0; m < members; ++m) {
+    double t = -3.0 * rng.uniform();  // the flow runs before both windows open
+    while (t < tracerWindow) {
+      t += -std::log(1.0 - rng.uniform());  // outside, 1 s on average
+      const double d = rng.uniform() < 1.0 / 3.0 ? 0.5 + rng.uniform() : 0.01 + 0.2 * rng.uniform();
+      if (t >= 0.0 && t + d <= referenceWindow) reference.push_back(std::round(d * 1000.0) / 1000.0);
+      if (t >= 0.0 && t + d <= tracerWindow) {
+        const auto k = std::int64_t(std::ceil((t + d) / dt) - std::ceil(t / dt));
+        ++tracerCounts[std::size_t(k)];
+      }
+      t += d;
+    }
+  }
+  const auto c = analysis::compareStays(tracerCounts, dt, members, tracerWindow, reference, members, referenceWindow);
+  EXPECT_LT(std::abs(c.meanError()), 0.04) << c.toJson().dump(1);
+  EXPECT_LT(std::abs(c.crossingRateError()), 0.04) << c.toJson().dump(1);
+  EXPECT_LT(c.ksDistance, 0.03) << c.toJson().dump(1);
+  EXPECT_EQ(c.longestCompared, 1.0);
+  EXPECT_GT(c.tracersBeyond, 0.05);  // the stays above 1 s are left out on both sides
+  EXPECT_GT(c.referenceBeyond, 0.02);
+
+  // Without the correction the two windows disagree although the flow is the same.
+  const auto rawTracers = analysis::summariseStays(analysis::fromStepCounts(tracerCounts, dt), members, tracerWindow);
+  const auto rawReference = analysis::summariseStays(analysis::onStepLattice(reference, dt), members, referenceWindow);
+  EXPECT_GT(rawTracers.mean_s / rawReference.mean_s, 1.15);
+}
