@@ -4,7 +4,7 @@
 # its instruction sets, AVX-512 included, but tunes for "generic", which emulates every gather with
 # scalar loads. The motion kernel gathers per lane (a cell's reach and speed, the sub-step lengths),
 # and tuned for the nearest CPU GCC knows it runs 1.09-1.13x as fast on such a machine, with the same
-# results (docs/performance.md, "Twelfth session"). AMD CPUs are left alone: their gathers are slow
+# results (docs/performance.md, "Tracers", build tuning). AMD CPUs are left alone: their gathers are slow
 # and no measurement says which tuning suits them.
 #
 # Sets RCFD_NATIVE_TUNING to the extra flags (empty where none are needed).
