@@ -2,11 +2,13 @@
 // The bed is filled and settled once (DEM only) and cached as a checkpoint in $TMPDIR; the gas is then
 // ramped up over `ramp` s (untimed) and the timed part runs `seconds` of coupled simulation. Reports
 // wall (and CPU) seconds per simulated second, parcel-steps per second including the gas, the share of
-// the gas, the mean DEM sub-steps per gas step and the largest alpha_P.
+// the gas, the wall time of each DEM phase and the DEM steps per neighbour-list build, the mean DEM
+// sub-steps per gas step and the largest alpha_P.
 //   --quick: a tenth of the bed, ramp 0.02 s, 0.02 s timed (seconds).   Full: ramp 0.1 s, 0.2 s timed.
 //   RCFD_BENCH_CFDDEM_SECONDS=T: time T s instead; RCFD_BENCH_CFDDEM_RAMP=R: ramp R s;
 //   RCFD_BENCH_CFDDEM_SCENE=path: another scene file; RCFD_BENCH_CFDDEM_SAVE=path: the final state
-//   into a checkpoint; RCFD_BENCH_CFDDEM_START=path: start from such a checkpoint (no fill, no ramp);
+//   into a checkpoint; RCFD_BENCH_CFDDEM_START=path: start from such a checkpoint or from a database
+//   job's checkpoint.h5 (no fill, no ramp);
 //   RCFD_BENCH_CFDDEM_PGM=prefix: also writes alpha_P (mean over z) as prefix-N.pgm every 0.2 s and
 //   prefix-alpha.pgm at the end. A progress line every 0.05 s simulated goes to stderr.
 //   RCFD_BENCH_CFDDEM_SERIES=path: time, pressure drop and DEM steps of every coupling step.
@@ -67,9 +69,10 @@ nlohmann::json runCfdDem(const Options& o) {
                       std::to_string(shape[1]) + "x" + std::to_string(shape[2]) + "-settled.h5");
   const char* startPath = std::getenv("RCFD_BENCH_CFDDEM_START");
   if (startPath) {
-    // A developed state (saved by an earlier run with RCFD_BENCH_CFDDEM_SAVE) replaces fill and ramp.
+    // A developed state replaces fill and ramp: saved by an earlier run with RCFD_BENCH_CFDDEM_SAVE
+    // (/state), or a database job's checkpoint.h5 (/simulation).
     h5::File f(startPath, h5::File::Mode::ReadOnly);
-    sim.loadState(f, "/state");
+    sim.loadState(f, f.exists("/state") ? "/state" : "/simulation");
   } else if (std::filesystem::exists(cache)) {
     h5::File f(cache.string(), h5::File::Mode::ReadOnly);
     sim.loadState(f, "/state");
@@ -95,8 +98,9 @@ nlohmann::json runCfdDem(const Options& o) {
   const std::int64_t start = sim.demStep(), end = start + std::llround(seconds * stepsPerSecond);
   long couplingSteps = 0, pressureIterations = 0;
   double gasWall = 0.0, maxAlphaP = 0.0, maxCourant = 0.0;
-  const double demWall0 = sim.dem().timings().drift + sim.dem().timings().build + sim.dem().timings().pairs +
-                          sim.dem().timings().gather;
+  const DemTimings dem0 = sim.dem().timings();
+  const double demWall0 = dem0.drift + dem0.build + dem0.pairs + dem0.gather;
+  const long builds0 = sim.dem().neighbourList().builds();
   const double cpu0 = cpuSeconds();
   const auto t0 = std::chrono::steady_clock::now();
   const std::int64_t report = std::max<std::int64_t>(1, std::llround(0.05 * stepsPerSecond));
@@ -141,6 +145,13 @@ nlohmann::json runCfdDem(const Options& o) {
   out["mean_dem_steps_per_gas_step"] = double(end - start) / double(couplingSteps);
   out["mean_pressure_iterations"] = double(pressureIterations) / double(couplingSteps);
   out["dem_wall_share"] = demWall / wall;
+  const DemTimings& dem1 = sim.dem().timings();
+  out["dem_phase_wall_s"] = {{"kick_and_drift", dem1.drift - dem0.drift},
+                             {"neighbour_list", dem1.build - dem0.build},
+                             {"pair_forces", dem1.pairs - dem0.pairs},
+                             {"gather_walls_kick", dem1.gather - dem0.gather}};
+  out["dem_steps_per_neighbour_list_build"] =
+      double(end - start) / double(std::max(1L, sim.dem().neighbourList().builds() - builds0));
   out["gas_and_coupling_wall_share"] = gasWall / wall;
   out["max_alpha_p"] = maxAlphaP;
   out["max_courant"] = maxCourant;

@@ -80,16 +80,22 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
   if (!lo.allFinite() || !hi.allFinite())
     throw RunError("DEM: a particle position is not finite (the time step is too large or a "
                    "contact exploded)");
+  // The cells are as small as the interaction distance allows, so the 27-cell stencil holds few
+  // candidates: a bed that fills a small part of its bounding box (a fountain above it, a tall
+  // chamber) still has about 2 parcels per cell where it is dense. Only when the box is so large that
+  // the cell offsets would not fit kMaxCellsPerParticle per particle (particles escaped far apart) are
+  // the cells made coarser, by the factor that fits, which stays correct and only costs candidates.
   double cell = 2.0 * r_max + skin_;
   long nc[3];
+  const double maxCells = double(kMaxCellsPerParticle) * double(n) + 4096.0;
   for (;;) {
-    long total = 1;
+    double total = 1.0;
     for (int a = 0; a < 3; ++a) {
-      nc[a] = std::max(1L, static_cast<long>((hi[a] - lo[a]) / cell));
-      total *= nc[a];
+      nc[a] = std::max(1L, static_cast<long>(std::min((hi[a] - lo[a]) / cell, 1e6)));
+      total *= double(nc[a]);
     }
-    if (total <= 4 * n + 64) break;  // particles escaped far apart: coarser cells, still correct
-    cell *= 2.0;
+    if (total <= maxCells) break;
+    cell *= std::max(1.01, std::cbrt(total / maxCells));
   }
   const Vector3d inv_cell(nc[0] / std::max(hi[0] - lo[0], 1e-300), nc[1] / std::max(hi[1] - lo[1], 1e-300),
                           nc[2] / std::max(hi[2] - lo[2], 1e-300));

@@ -19,6 +19,9 @@ namespace rcfd {
 class NeighbourList {
  public:
   using Index = std::uint32_t;
+  /// Linked cells allowed per particle before the cells grow beyond the interaction distance (4 bytes
+  /// of offsets each: a sparse bed in a tall chamber needs tens of cells per particle).
+  static constexpr long kMaxCellsPerParticle = 64;
 
   /// skin: extra distance beyond contact [m] within which pairs are listed.
   explicit NeighbourList(double skin = 0.0) : skin_(skin) {}

@@ -155,6 +155,46 @@ TEST(Bed, BitIdenticalForOneAndTwoThreads) {
   for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "particle " << i;
 }
 
+/// The pairs (i < j) within r_i + r_j + skin, by brute force.
+std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> pairsWithinReach(const DemParticles& p, double skin) {
+  std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> out;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t k = i + 1; k < p.size(); ++k) {
+      const double cut = p.radius[i] + p.radius[k] + skin;
+      if ((p.x[k] - p.x[i]).squaredNorm() < cut * cut) out.emplace_back(NeighbourList::Index(i), NeighbourList::Index(k));
+    }
+  return out;
+}
+
+TEST(NeighbourList, ListsExactlyThePairsWithinReachHoweverLargeTheBoxAroundThem) {
+  // A dense cluster in a tall box with a sparse fountain above it (fine linked cells, tens per
+  // particle), then the same with two particles escaped 1 km away (cells coarsened to fit): the list
+  // holds exactly the pairs a brute-force search finds, each row sorted.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double r = 1e-3, skin = 0.4 * r;
+  DemParticles p;
+  for (int i = 0; i < 1500; ++i) p.add(Vector3d(0.03 * u(rng), 0.03 * u(rng), 0.01 * u(rng)), Vector3d::Zero(), r * (0.8 + 0.4 * u(rng)), 1000.0);
+  for (int i = 0; i < 100; ++i) p.add(Vector3d(0.03 * u(rng), 0.03 + 0.5 * u(rng), 0.01 * u(rng)), Vector3d::Zero(), r, 1000.0);
+  for (const bool escaped : {false, true}) {
+    if (escaped) {
+      p.add(Vector3d(1000.0, 0.0, 0.0), Vector3d::Zero(), r, 1000.0);
+      p.add(Vector3d(0.0, -1000.0, 1000.0), Vector3d::Zero(), r, 1000.0);
+    }
+    NeighbourList list(skin);
+    list.build(p, DemWalls());
+    std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> listed;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (auto q = list.row_start[i]; q < list.row_start[i + 1]; ++q) {
+        if (q > list.row_start[i]) EXPECT_LT(list.j[q - 1], list.j[q]);
+        listed.emplace_back(NeighbourList::Index(i), list.j[q]);
+      }
+    const auto expected = pairsWithinReach(p, skin);
+    EXPECT_GT(expected.size(), 1000u);
+    EXPECT_EQ(listed, expected) << (escaped ? "with particles far away" : "a bed and a fountain");
+  }
+}
+
 TEST(NeighbourList, TangentialHistorySurvivesRebuilds) {
   // A locked sphere held on a 10 deg incline by static friction (tan 10 deg < mu) keeps its
   // tangential spring across forced list rebuilds: without the history it would creep downhill.
