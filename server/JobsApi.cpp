@@ -8,7 +8,9 @@
 #include "Ids.hpp"
 #include "Problem.hpp"
 #include "WorkerPool.hpp"
+#include "scene/SceneJson.hpp"
 #include "scene/SceneLoader.hpp"
+#include "scene/SchemaValidator.hpp"
 
 namespace rcfd::server {
 
@@ -129,6 +131,17 @@ Response JobsApi::submit(const Request& req, const Target& target) {
     spec = loadJob(document, "job");
   } catch (const InputError& e) {
     return invalidInput(e, target.path);
+  }
+  // The solver opens a file a scene names as the server's user: a job could read any file the server
+  // can (its first word lands in the job's error). No such field is taken, inline or patched.
+  const nlohmann::json scene = sceneToJson(spec.scene);
+  for (const std::string& pointer : SchemaValidator::get("scene").filePathPointers()) {
+    const nlohmann::json::json_pointer at(pointer);
+    if (scene.contains(at) && scene[at].is_string() && !scene[at].get<std::string>().empty())
+      return invalidInput(InputError("job", "/scene" + pointer,
+                                     "the server opens no file a job names (set inline or through "
+                                     "/scene_patch): run this scene with rcfd-solve instead"),
+                          target.path);
   }
   if (spec.kind != "database" && spec.database.empty())
     return invalidInput(InputError("job", "/database",

@@ -1,5 +1,6 @@
 #include "scene/SchemaValidator.hpp"
 
+#include <algorithm>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -67,6 +68,31 @@ SchemaValidator::SchemaValidator(const std::string& name)
 }
 
 SchemaValidator::~SchemaValidator() = default;
+
+namespace {
+
+void collectFilePaths(const nlohmann::json& root, const nlohmann::json& node, const std::string& pointer,
+                      std::vector<std::string>& out, int depth) {
+  if (!node.is_object() || depth > 64) return;
+  if (node.value("x-file-path", false) && std::find(out.begin(), out.end(), pointer) == out.end()) out.push_back(pointer);
+  if (const auto ref = node.find("$ref"); ref != node.end() && ref->is_string()) {
+    const std::string target = ref->get<std::string>();
+    if (target.rfind("#/", 0) == 0) collectFilePaths(root, root.at(nlohmann::json::json_pointer(target.substr(1))), pointer, out, depth + 1);
+  }
+  for (const char* branch : {"oneOf", "anyOf", "allOf"})
+    if (const auto b = node.find(branch); b != node.end() && b->is_array())
+      for (const auto& sub : *b) collectFilePaths(root, sub, pointer, out, depth + 1);
+  if (const auto props = node.find("properties"); props != node.end() && props->is_object())
+    for (const auto& [name, sub] : props->items()) collectFilePaths(root, sub, appendPointer(pointer, name), out, depth + 1);
+}
+
+}  // namespace
+
+std::vector<std::string> SchemaValidator::filePathPointers() const {
+  std::vector<std::string> out;
+  collectFilePaths(json_, json_, "", out, 0);
+  return out;
+}
 
 const SchemaValidator& SchemaValidator::get(const std::string& name) {
   static std::mutex mutex;

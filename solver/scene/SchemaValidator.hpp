@@ -31,6 +31,11 @@ class SchemaValidator {
   bool conforms(const nlohmann::json& document, std::vector<Violation>* rawErrors = nullptr) const;
 
   const nlohmann::json& schema() const { return json_; }
+
+  /// Pointers (into a document) of the string properties the schema marks "x-file-path": a file the
+  /// solver opens by name. Follows "properties", local "$ref"s and oneOf/anyOf/allOf branches, not
+  /// array items (no path lives in an array). A server refuses every one of them (the CLI opens them).
+  std::vector<std::string> filePathPointers() const;
   const std::string& text() const { return text_; }
 
   ~SchemaValidator();

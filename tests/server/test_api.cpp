@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "ServerFixture.hpp"
+#include "scene/SchemaValidator.hpp"
 
 using namespace rcfd::test;
 namespace http = boost::beast::http;
@@ -89,6 +90,67 @@ TEST_F(Api, SceneFileIsRefusedByTheServer) {
   const auto r = server_->post("/v1/jobs", job.dump());
   expectProblem(r, 422);
   EXPECT_EQ(r.json().at("errors").at(0).at("pointer"), "/scene_file");
+}
+
+namespace {
+
+/// Pointers of the string properties whose name says they hold a file or directory, found by walking
+/// the schema the way SchemaValidator::filePathPointers() does, but by name instead of annotation.
+void pathLikeProperties(const nlohmann::json& root, const nlohmann::json& node, const std::string& pointer,
+                        std::vector<std::string>& out, int depth = 0) {
+  if (!node.is_object() || depth > 64) return;
+  if (const auto ref = node.find("$ref"); ref != node.end() && ref->get<std::string>().rfind("#/", 0) == 0)
+    pathLikeProperties(root, root.at(nlohmann::json::json_pointer(ref->get<std::string>().substr(1))), pointer, out, depth + 1);
+  for (const char* branch : {"oneOf", "anyOf", "allOf"})
+    if (node.contains(branch))
+      for (const auto& sub : node.at(branch)) pathLikeProperties(root, sub, pointer, out, depth + 1);
+  if (!node.contains("properties")) return;
+  for (const auto& [name, sub] : node.at("properties").items()) {
+    std::string lower = name;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const bool named = lower.find("file") != std::string::npos || lower.find("dir") != std::string::npos ||
+                       lower == "path" || lower.find("_path") != std::string::npos;
+    if (named && sub.value("type", "") == "string" && std::find(out.begin(), out.end(), pointer + "/" + name) == out.end())
+      out.push_back(pointer + "/" + name);
+    pathLikeProperties(root, sub, pointer + "/" + name, out, depth + 1);
+  }
+}
+
+}  // namespace
+
+TEST_F(Api, NoFileTheSolverWouldOpenIsTakenFromAJob) {
+  // Every string property named like a file or directory is marked x-file-path in its schema (so one
+  // added later is caught here), and the server refuses each one set in a job's scene, inline or
+  // patched: the solver would open it as the server's user.
+  std::vector<std::string> named, marked;
+  for (const std::string schema : {"scene", "job"}) {
+    const auto& v = rcfd::SchemaValidator::get(schema);
+    std::vector<std::string> n;
+    pathLikeProperties(v.schema(), v.schema(), "", n);
+    for (const auto& p : n) named.push_back(schema + ":" + p);
+    for (const auto& p : v.filePathPointers()) marked.push_back(schema + ":" + p);
+  }
+  std::sort(named.begin(), named.end());
+  std::sort(marked.begin(), marked.end());
+  EXPECT_EQ(named, marked);
+  ASSERT_NE(std::find(marked.begin(), marked.end(), "scene:/rcfd/path/file"), marked.end());
+
+  for (const auto& pointer : rcfd::SchemaValidator::get("scene").filePathPointers()) {
+    const nlohmann::json::json_pointer at(pointer);
+    auto inlineJob = databaseJob();
+    inlineJob["scene"][at] = "/etc/passwd";
+    auto patched = databaseJob();
+    patched["scene_patch"] = nlohmann::json::object();
+    patched["scene_patch"][at] = "/etc/passwd";
+    for (const auto& job : {inlineJob, patched}) {
+      const auto r = server_->post("/v1/jobs", job.dump());
+      expectProblem(r, 422);
+      EXPECT_EQ(r.json().at("errors").at(0).at("pointer"), "/scene" + pointer) << r.body;
+      EXPECT_EQ(r.body.find("root:"), std::string::npos) << r.body;  // nothing of the file in the reply
+    }
+  }
+  EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
+  expectStillServing();
 }
 
 TEST_F(Api, UnknownOrFailedDatabaseReferenceIs422) {
