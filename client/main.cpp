@@ -1,6 +1,7 @@
 // rcfd: the command-line client of rcfd-server (docs/api.md). Exit codes: 0 success, 1 the server or
 // the job failed (or cannot be reached), 2 usage error or input the server rejected as invalid.
 
+#include <algorithm>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -110,7 +111,7 @@ void printStatus(const json& job) {
             << "  sim_time " << fmtNumber(p["sim_time"]) << " s  eta " << fmtNumber(p["eta_s"]) << " s\n";
   for (const char* key : {"database", "created_at", "started_at", "finished_at", "error"})
     if (job.contains(key) && job[key].is_string())
-      std::cout << key << ":" << std::string(10 - std::string(key).size(), ' ')
+      std::cout << key << ":" << std::string(std::max<std::size_t>(1, 10 - std::min<std::size_t>(10, std::string(key).size())), ' ')
                 << job[key].get<std::string>() << "\n";
   if (job.contains("artifacts") && !job["artifacts"].empty()) {
     std::cout << "artifacts:";

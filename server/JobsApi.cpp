@@ -110,16 +110,12 @@ nlohmann::json JobsApi::toJson(const JobRecord& job, bool withRequest) const {
 }
 
 Response JobsApi::submit(const Request& req, const Target& target) {
-  auto document = nlohmann::json::parse(req.body(), nullptr, false);
-  if (document.is_discarded()) {
-    std::string detail = "the request body is not valid JSON";
-    try {
-      const auto ignored = nlohmann::json::parse(req.body());
-      (void)ignored;
-    } catch (const nlohmann::json::parse_error& e) {
-      detail += ": " + std::string(e.what());
-    }
-    return problem(http::status::bad_request, "invalid-json", "Malformed JSON", detail, target.path);
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(req.body());
+  } catch (const nlohmann::json::exception& e) {  // syntax, and numbers beyond double range
+    return problem(http::status::bad_request, "invalid-json", "Malformed JSON",
+                   "the request body is not valid JSON: " + std::string(e.what()), target.path);
   }
   if (document.is_object() && document.contains("scene_file"))
     return invalidInput(

@@ -66,6 +66,17 @@ TEST_F(Api, InvalidJsonIs400) {
   expectStillServing();
 }
 
+TEST_F(Api, ANumberBeyondDoubleRangeIs400) {
+  auto job = databaseJob();
+  job.erase("seed");
+  std::string body = job.dump();
+  body.insert(body.find('{') + 1, "\"seed\": 1e400, ");
+  const auto r = server_->post("/v1/jobs", body);
+  expectProblem(r, 400);
+  EXPECT_NE(r.json().at("detail").get<std::string>().find("1e400"), std::string::npos) << r.body;
+  expectStillServing();
+}
+
 TEST_F(Api, SchemaViolationIs422WithPointer) {
   auto job = databaseJob();
   job["kind"] = "teleport";

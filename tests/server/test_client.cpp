@@ -86,6 +86,11 @@ TEST_F(Client, SubmitStatusJobsCancel) {
   EXPECT_EQ(cancel.code, 0) << cancel.err;
   EXPECT_NE(cancel.out.find("CANCELLED"), std::string::npos);
   EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "CANCELLED");
+  // A finished job's status shows when it finished.
+  const auto finished = runClient({"status", id}, env());
+  EXPECT_EQ(finished.code, 0) << finished.err;
+  EXPECT_NE(finished.out.find("state:     CANCELLED"), std::string::npos) << finished.out;
+  EXPECT_NE(finished.out.find("finished_at: "), std::string::npos) << finished.out;
   // Waiting on a cancelled job ends at once with exit 1 and says why.
   const auto wait = runClient({"wait", id}, env());
   EXPECT_EQ(wait.code, 1);
