@@ -103,6 +103,16 @@ void checkApparatus(const ApparatusSpec& a, std::vector<Violation>& out) {
   }
 }
 
+/// Open volume of the chamber [m3]: the box, or the prism's cross-section (width x height less the
+/// V-bottom's two wedges and the draft plates) times its depth.
+double chamberOpenVolume(const ApparatusSpec& a) {
+  if (a.type == ApparatusSpec::Type::Box) return a.size.x() * a.size.y() * a.size.z();
+  const double vTop = 0.5 * (a.width - a.inlet_width) * tanDeg(a.prism_angle_deg);
+  double area = a.width * a.height - 0.5 * (a.width - a.inlet_width) * vTop;
+  if (a.draft_plates) area -= 2.0 * a.draft_plates->thickness * a.draft_plates->height;
+  return std::max(0.0, area) * a.depth;
+}
+
 }  // namespace
 
 void apparatusBounds(const ApparatusSpec& a, Vec3& lower, Vec3& upper) {
@@ -113,6 +123,22 @@ void apparatusBounds(const ApparatusSpec& a, Vec3& lower, Vec3& upper) {
     lower = Vec3(-0.5 * a.width, 0.0, 0.0);
     upper = Vec3(0.5 * a.width, a.height, a.depth);
   }
+}
+
+std::vector<Violation> checkDatabaseScene(const Scene& s) {
+  std::vector<Violation> out;
+  // A bed that cannot fit the chamber even packed as densely as a random packing gets (0.64) is refused
+  // before the job starts: the DEM fill would otherwise try to insert it for as long as it runs.
+  constexpr double kDensestRandomPacking = 0.64;
+  const double chamber = chamberOpenVolume(s.apparatus);
+  const double packed = s.process.bed_mass / (kDensestRandomPacking * s.particles.density);
+  if (packed > chamber) {
+    out.push_back({"/process/bed_mass", num(s.process.bed_mass) + " kg packs (alpha_P " + num(kDensestRandomPacking) +
+                                            ") into " + num(packed) + " m3, more than the chamber's open volume " +
+                                            num(chamber) + " m3: at most " +
+                                            num(chamber * kDensestRandomPacking * s.particles.density) + " kg fits"});
+  }
+  return out;
 }
 
 std::vector<Violation> documentLimitViolations(const json& document) {

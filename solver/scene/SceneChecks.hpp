@@ -24,6 +24,10 @@ inline constexpr int kMaxDocumentDepth = 32;
 inline constexpr std::size_t kMaxArrayItems = 100000;
 std::vector<Violation> documentLimitViolations(const nlohmann::json& document);
 
+/// Rules a scene must meet to be simulated by the CFD-DEM of a database job (pointers into the scene):
+/// the bed fits the chamber.
+std::vector<Violation> checkDatabaseScene(const Scene& scene);
+
 /// Lower and upper corner of the apparatus's bounding box (CONTRACTS.md coordinates) [m].
 void apparatusBounds(const ApparatusSpec& apparatus, Vec3& lower, Vec3& upper);
 

@@ -146,6 +146,10 @@ JobSpec loadJob(const json& document, const std::string& source, const std::stri
     }
   }
   if (!violations.empty()) throw InputError(source, std::move(violations));
+  if (job.kind == "database") {
+    violations = checkDatabaseScene(job.scene);
+    if (!violations.empty()) throw InputError(source, prefixed(std::move(violations), "/scene"));
+  }
   return job;
 }
 

@@ -133,6 +133,27 @@ TEST(Jobs, ScenePatchThatBreaksTheSceneIsRefusedWithItsPointer) {
   EXPECT_EQ(refusedPointers({{"kind", "database"}, {"scene", quickScene()}, {"scene_patch", 3}}), V{"/scene_patch"});
 }
 
+TEST(Jobs, ADatabaseJobWhoseBedCannotFitTheChamberIsRefusedBeforeItStarts) {
+  // The quick slice's chamber holds 2.54e-3 m3: at most 1.69 kg of its particles packed at 0.64.
+  json scene = quickScene();
+  scene["process"]["bed_mass"] = 1e12;
+  try {
+    loadJob({{"kind", "database"}, {"scene", scene}}, "job");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.violations().size(), 1u) << e.what();
+    EXPECT_EQ(e.violations()[0].pointer, "/scene/process/bed_mass");
+    EXPECT_NE(e.violations()[0].message.find("at most 1.69"), std::string::npos) << e.what();
+  }
+  scene["process"]["bed_mass"] = 1.6;  // fits, packed
+  EXPECT_NO_THROW(loadJob({{"kind", "database"}, {"scene", scene}}, "job"));
+  scene["process"]["bed_mass"] = 1.7;
+  EXPECT_THROW(loadJob({{"kind", "database"}, {"scene", scene}}, "job"), InputError);
+  // Only the CFD-DEM fills the bed: a spray job on such a scene counts particles, nothing more.
+  scene["process"]["bed_mass"] = 1e12;
+  EXPECT_NO_THROW(loadJob({{"kind", "spray"}, {"scene", scene}, {"database", "db.h5"}, {"duration", 1.0}}, "job"));
+}
+
 TEST(Jobs, SchemaTextsAreServed) {
   EXPECT_NE(schemaText("scene").find("\"effects\""), std::string::npos);
   EXPECT_NE(schemaText("job").find("\"scene_file\""), std::string::npos);

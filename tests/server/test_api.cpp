@@ -77,6 +77,15 @@ TEST_F(Api, ANumberBeyondDoubleRangeIs400) {
   expectStillServing();
 }
 
+TEST_F(Api, ADatabaseJobWhoseBedCannotFitIsRefusedAtSubmit) {
+  auto job = databaseJob();
+  job["scene"]["process"]["bed_mass"] = 1e12;
+  const auto r = server_->post("/v1/jobs", job.dump());
+  expectProblem(r, 422);
+  EXPECT_EQ(r.json().at("errors").at(0).at("pointer"), "/scene/process/bed_mass") << r.body;
+  EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
+}
+
 TEST_F(Api, SchemaViolationIs422WithPointer) {
   auto job = databaseJob();
   job["kind"] = "teleport";
