@@ -17,8 +17,9 @@ constexpr std::size_t kDrainLimit = 64u << 20;        // unread body bytes disca
 constexpr auto kDrainTimeout = std::chrono::seconds(5);
 }  // namespace
 
-HttpSession::HttpSession(net::ip::tcp::socket&& socket, Router& router, net::thread_pool& blocking)
-    : stream_(std::move(socket)), router_(router), blocking_(blocking) {}
+HttpSession::HttpSession(net::ip::tcp::socket&& socket, Router& router, net::thread_pool& blocking,
+                         std::shared_ptr<void> ticket)
+    : stream_(std::move(socket)), router_(router), blocking_(blocking), ticket_(std::move(ticket)) {}
 
 HttpSession::~HttpSession() {
   if (!uploadPath_.empty()) {
@@ -41,7 +42,9 @@ void HttpSession::doRead() {
   header_->body_limit(std::numeric_limits<std::uint64_t>::max());
   body_.reset();
   upload_.reset();
-  stream_.expires_after(router_.config().readTimeout);
+  // A connection that never sent a token holds a descriptor for a few seconds only.
+  const auto& config = router_.config();
+  stream_.expires_after(tokenSeen_ ? config.readTimeout : std::min(config.readTimeout, config.idleBeforeToken));
   http::async_read_header(stream_, buffer_, *header_,
                           beast::bind_front_handler(&HttpSession::onHeader, shared_from_this()));
 }
@@ -75,6 +78,8 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
   if (ec) return readError(ec);
   started_ = std::chrono::steady_clock::now();
   const auto& req = header_->get();
+  tokenSeen_ = tokenSeen_ || req.find(http::field::authorization) != req.end();
+  stream_.expires_after(router_.config().readTimeout);  // the body may take the full read time
   const std::string_view target(req.target().data(), req.target().size());
   const auto tooLarge = [&](std::uint64_t length, std::uint64_t limit) {
     return problem(http::status::payload_too_large, "body-too-large", "Request body too large",

@@ -22,8 +22,9 @@ namespace rcfd::server {
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(boost::asio::ip::tcp::socket&& socket, Router& router,
-              boost::asio::thread_pool& blocking);
+  /// `ticket` is held for the session's lifetime (the listener's count of open connections).
+  HttpSession(boost::asio::ip::tcp::socket&& socket, Router& router, boost::asio::thread_pool& blocking,
+              std::shared_ptr<void> ticket = {});
   ~HttpSession();
   /// Starts reading on the session's strand.
   void run();
@@ -53,6 +54,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   int status_ = 0;
   std::size_t drained_ = 0;
   std::array<char, 16384> scratch_{};
+  std::shared_ptr<void> ticket_;
+  bool tokenSeen_ = false;  ///< a request carried an Authorization header: the long idle time applies
 };
 
 }  // namespace rcfd::server

@@ -1,11 +1,19 @@
 #pragma once
 /// \file Listener.hpp
-/// Accepts connections and starts one HttpSession for each, on its own strand.
+/// Accepts connections and starts one HttpSession for each, on its own strand. Open connections are
+/// capped in total and per peer address (a connection beyond a cap is closed at once); when accept
+/// fails (descriptors used up) it retries after a back-off of 10 ms doubling to 1 s instead of at
+/// once, and says so on stderr at most once every 10 s.
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/thread_pool.hpp>
+#include <chrono>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
+#include <string>
 
 namespace rcfd::server {
 
@@ -26,11 +34,26 @@ class Listener : public std::enable_shared_from_this<Listener> {
  private:
   void doAccept();
   void onAccept(boost::system::error_code ec, boost::asio::ip::tcp::socket socket);
+  /// A ticket for a new connection from `peer`, released when the session ends; null over a cap.
+  std::shared_ptr<void> admit(const std::string& peer);
+  /// One stderr line, unless one was written less than 10 s ago (then it is counted and summarised).
+  void logLimited(const std::string& line);
 
   boost::asio::io_context& ioc_;
   boost::asio::ip::tcp::acceptor acceptor_;
   Router& router_;
   boost::asio::thread_pool& blocking_;
+  boost::asio::steady_timer retry_;
+  std::chrono::milliseconds backoff_{0};
+  std::chrono::steady_clock::time_point lastLog_{};
+  long suppressedLines_ = 0;
+  /// Open connections, shared with the tickets (which outlive neither the listener's strand nor it).
+  struct Counts {
+    std::mutex mutex;
+    int total = 0;
+    std::map<std::string, int> perPeer;
+  };
+  std::shared_ptr<Counts> counts_ = std::make_shared<Counts>();
 };
 
 }  // namespace rcfd::server

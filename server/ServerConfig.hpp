@@ -18,6 +18,9 @@ struct ServerConfig {
   std::uint64_t jsonBodyLimit = 1u << 20;            ///< bytes of a JSON request body
   std::uint64_t uploadLimit = 8ull << 30;            ///< bytes of an uploaded database
   std::chrono::seconds readTimeout{30};              ///< header and JSON body read timeout
+  std::chrono::seconds idleBeforeToken{5};           ///< header read timeout until a request carried a token
+  int maxConnections = 1024;                         ///< open connections in total (at most the descriptor limit less 64)
+  int maxConnectionsPerPeer = 512;                   ///< open connections from one address (a proxy counts as one)
   std::chrono::seconds uploadTimeout{3600};          ///< whole-upload timeout
   std::chrono::seconds shutdownGrace{120};           ///< wait for solvers to checkpoint on stop
 

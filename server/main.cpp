@@ -2,6 +2,7 @@
 // line, opens the store, starts the worker pool and the listener, and shuts down on SIGINT/SIGTERM:
 // stop accepting, then let running solvers checkpoint (their jobs resume on the next start).
 
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -109,6 +110,15 @@ int main(int argc, char** argv) {
   app.add_option("--max-body-bytes", maxBody, "limit of a JSON request body")->capture_default_str();
   app.add_option("--max-upload-bytes", maxUpload, "limit of a database upload")->capture_default_str();
   app.add_option("--shutdown-grace", graceSeconds, "seconds solvers get to checkpoint on shutdown")->capture_default_str();
+  int idleBeforeToken = static_cast<int>(config.idleBeforeToken.count());
+  app.add_option("--idle-before-token", idleBeforeToken,
+                 "seconds a connection may wait for its first request with a token before it is closed")
+      ->capture_default_str()->check(CLI::Range(1, 3600));
+  auto* maxConnections = app.add_option("--max-connections", config.maxConnections,
+                                        "open connections in total (default: 1024, at most the descriptor limit less 64)")
+      ->capture_default_str()->check(CLI::Range(1, 1000000));
+  app.add_option("--max-connections-per-peer", config.maxConnectionsPerPeer, "open connections from one address")
+      ->capture_default_str()->check(CLI::Range(1, 1000000));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -121,6 +131,11 @@ int main(int argc, char** argv) {
     config.jsonBodyLimit = maxBody;
     config.uploadLimit = maxUpload;
     config.shutdownGrace = std::chrono::seconds(graceSeconds);
+    config.idleBeforeToken = std::chrono::seconds(idleBeforeToken);
+    // Connections beyond the descriptor limit would make accept fail: keep 64 for SQLite, logs, solvers.
+    if (rlimit files{}; maxConnections->count() == 0 && ::getrlimit(RLIMIT_NOFILE, &files) == 0 &&
+                        files.rlim_cur != RLIM_INFINITY)
+      config.maxConnections = std::max(1, std::min(config.maxConnections, int(files.rlim_cur) - 64));
     if (config.workers > 0 && ::access(config.solverPath.c_str(), X_OK) != 0)
       std::cerr << "rcfd-server: warning: solver " << config.solverPath.string()
                 << " is not executable; jobs will fail (use --solver)\n";

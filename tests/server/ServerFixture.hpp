@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -95,8 +96,9 @@ inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, c
 /// A running rcfd-server child process.
 class ServerProcess {
  public:
+  /// fileLimit > 0: the server runs with at most that many open descriptors (RLIMIT_NOFILE).
   ServerProcess(const std::filesystem::path& dataDir, std::string token,
-                std::vector<std::string> extraArgs = {"--workers", "0"})
+                std::vector<std::string> extraArgs = {"--workers", "0"}, int fileLimit = 0)
       : dataDir_(dataDir), token_(std::move(token)) {
     const auto binary = binaryDir() / "rcfd-server";
     const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
@@ -112,6 +114,10 @@ class ServerProcess {
     stderrPath_ = dataDir.parent_path() / (dataDir.filename().string() + ".stderr");
     pid_ = ::fork();
     if (pid_ == 0) {
+      if (fileLimit > 0) {
+        const rlimit limit{rlim_t(fileLimit), rlim_t(fileLimit)};
+        ::setrlimit(RLIMIT_NOFILE, &limit);
+      }
       ::dup2(out[1], 1);
       const int err = ::open(stderrPath_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
       ::dup2(err, 2);
