@@ -30,8 +30,8 @@ std::string HttpResponse::contentType() const {
   return it == headers.end() ? std::string() : it->second;
 }
 
-HttpClient::HttpClient(const std::string& server, std::string token)
-    : server_(server), token_(std::move(token)) {
+HttpClient::HttpClient(const std::string& server, std::string token, std::chrono::seconds timeout)
+    : server_(server), token_(std::move(token)), timeout_(timeout) {
   constexpr std::string_view scheme = "http://";
   if (server.rfind(scheme, 0) != 0)
     throw std::invalid_argument("server URL must start with http:// (got \"" + server + "\")");
@@ -51,29 +51,72 @@ HttpClient::HttpClient(const std::string& server, std::string token)
 
 namespace {
 
-template <class RequestBody, class ResponseParser>
-void exchange(const std::string& host, const std::string& port,
-              http::request<RequestBody>& req, ResponseParser& parser, const std::string& server) {
-  net::io_context ioc;
+/// A connection to the server within `timeout`; every later send and receive on it fails after
+/// `timeout` without progress (SO_SNDTIMEO / SO_RCVTIMEO), so a stopped server cannot hang the client.
+void connect(net::io_context& ioc, beast::tcp_stream& stream, const std::string& host, const std::string& port,
+             const std::string& server, std::chrono::seconds timeout) {
   tcp::resolver resolver(ioc);
-  beast::tcp_stream stream(ioc);
   beast::error_code ec;
   auto results = resolver.resolve(host, port, ec);
   if (ec) throw ConnectionError("cannot resolve " + server + ": " + ec.message());
-  stream.connect(results, ec);
-  if (ec)
-    throw ConnectionError("cannot connect to " + server + ": " + ec.message() +
+  stream.expires_after(timeout);
+  beast::error_code connectEc = net::error::would_block;
+  stream.async_connect(results, [&](beast::error_code e, const tcp::endpoint&) { connectEc = e; });
+  ioc.run();
+  ioc.restart();
+  if (connectEc == beast::error::timeout)
+    throw ConnectionError("no connection to " + server + " within " + std::to_string(timeout.count()) +
+                          " s (is rcfd-server running and reachable? --timeout or RCFD_TIMEOUT)");
+  if (connectEc)
+    throw ConnectionError("cannot connect to " + server + ": " + connectEc.message() +
                           " (is rcfd-server running? set --server or RCFD_SERVER)");
+  stream.expires_never();
+}
+
+/// Runs one asynchronous operation on `stream` to its end, cancelled after `timeout` without it
+/// completing (Beast's stream timeout: a stopped server cannot hang the client).
+template <class Start>
+beast::error_code runFor(net::io_context& ioc, beast::tcp_stream& stream, std::chrono::seconds timeout, Start&& start) {
+  beast::error_code result = net::error::would_block;
+  stream.expires_after(timeout);
+  start([&](beast::error_code e, std::size_t) { result = e; });
+  ioc.run();
+  ioc.restart();
+  stream.expires_never();
+  return result;
+}
+
+/// Reads a message into `parser`, each piece within `timeout` (an idle limit, not a total one: a large
+/// download may take as long as it keeps arriving).
+template <class Parser>
+beast::error_code readWithin(net::io_context& ioc, beast::tcp_stream& stream, beast::flat_buffer& buffer,
+                             Parser& parser, std::chrono::seconds timeout, bool headerOnly = false) {
+  while (headerOnly ? !parser.is_header_done() : !parser.is_done()) {
+    const auto ec = runFor(ioc, stream, timeout, [&](auto&& done) { http::async_read_some(stream, buffer, parser, done); });
+    if (ec) return ec;
+  }
+  return {};
+}
+
+/// The message of a failed read or write: a timeout says so.
+std::string failure(const beast::error_code& ec, std::chrono::seconds timeout) {
+  if (ec == beast::error::timeout)
+    return "no answer within " + std::to_string(timeout.count()) + " s (--timeout or RCFD_TIMEOUT)";
+  return ec.message();
+}
+
+template <class RequestBody, class ResponseParser>
+void exchange(const std::string& host, const std::string& port, http::request<RequestBody>& req,
+              ResponseParser& parser, const std::string& server, std::chrono::seconds timeout) {
+  net::io_context ioc;
+  beast::tcp_stream stream(ioc);
+  connect(ioc, stream, host, port, server, timeout);
   req.prepare_payload();
-  http::write(stream, req, ec);
+  beast::error_code ec = runFor(ioc, stream, timeout, [&](auto&& done) { http::async_write(stream, req, done); });
   beast::flat_buffer buffer;
   // The server may answer early (e.g. 413) and close while we still send: read its answer anyway.
-  beast::error_code readEc;
-  http::read(stream, buffer, parser, readEc);
-  if (readEc) {
-    throw ConnectionError("no valid answer from " + server + ": " +
-                          (ec ? ec.message() : readEc.message()));
-  }
+  const beast::error_code readEc = readWithin(ioc, stream, buffer, parser, timeout);
+  if (readEc) throw ConnectionError("no valid answer from " + server + ": " + failure(ec && ec != beast::error::timeout ? ec : readEc, timeout));
   stream.socket().shutdown(tcp::socket::shutdown_both, ec);
 }
 
@@ -85,7 +128,7 @@ HttpResponse HttpClient::get(const std::string& target) {
   if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
   http::response_parser<http::string_body> parser;
   parser.body_limit(kMaxResponseBody);
-  exchange(host_, port_, req, parser, server_);
+  exchange(host_, port_, req, parser, server_, timeout_);
   HttpResponse out;
   out.status = parser.get().result_int();
   copyHeaders(parser.get(), out);
@@ -103,7 +146,7 @@ HttpResponse HttpClient::post(const std::string& target, const std::string& json
   req.body() = jsonBody;
   http::response_parser<http::string_body> parser;
   parser.body_limit(kMaxResponseBody);
-  exchange(host_, port_, req, parser, server_);
+  exchange(host_, port_, req, parser, server_, timeout_);
   HttpResponse out;
   out.status = parser.get().result_int();
   copyHeaders(parser.get(), out);
@@ -120,7 +163,7 @@ HttpResponse HttpClient::postFile(const std::string& target, const std::filesyst
   req.body().open(file.c_str(), beast::file_mode::scan, ec);
   if (ec) throw std::runtime_error("cannot read " + file.string() + ": " + ec.message());
   http::response_parser<http::string_body> parser;
-  exchange(host_, port_, req, parser, server_);
+  exchange(host_, port_, req, parser, server_, timeout_);
   HttpResponse out;
   out.status = parser.get().result_int();
   copyHeaders(parser.get(), out);
@@ -131,25 +174,19 @@ HttpResponse HttpClient::postFile(const std::string& target, const std::filesyst
 HttpResponse HttpClient::download(const std::string& target, const std::filesystem::path& file) {
   // Read the header first: only a 2xx body goes to the file, an error body stays in memory.
   net::io_context ioc;
-  tcp::resolver resolver(ioc);
   beast::tcp_stream stream(ioc);
+  connect(ioc, stream, host_, port_, server_, timeout_);
   beast::error_code ec;
-  auto results = resolver.resolve(host_, port_, ec);
-  if (ec) throw ConnectionError("cannot resolve " + server_ + ": " + ec.message());
-  stream.connect(results, ec);
-  if (ec)
-    throw ConnectionError("cannot connect to " + server_ + ": " + ec.message() +
-                          " (is rcfd-server running? set --server or RCFD_SERVER)");
   http::request<http::empty_body> req{http::verb::get, target, 11};
   req.set(http::field::host, host_);
   if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
-  http::write(stream, req, ec);
-  if (ec) throw ConnectionError("cannot send to " + server_ + ": " + ec.message());
+  ec = runFor(ioc, stream, timeout_, [&](auto&& done) { http::async_write(stream, req, done); });
+  if (ec) throw ConnectionError("cannot send to " + server_ + ": " + failure(ec, timeout_));
   beast::flat_buffer buffer;
   http::response_parser<http::empty_body> header;
   header.body_limit(kMaxResponseBody);
-  http::read_header(stream, buffer, header, ec);
-  if (ec) throw ConnectionError("no valid answer from " + server_ + ": " + ec.message());
+  ec = readWithin(ioc, stream, buffer, header, timeout_, /*headerOnly=*/true);
+  if (ec) throw ConnectionError("no valid answer from " + server_ + ": " + failure(ec, timeout_));
   HttpResponse out;
   out.status = header.get().result_int();
   copyHeaders(header.get(), out);
@@ -159,16 +196,16 @@ HttpResponse HttpClient::download(const std::string& target, const std::filesyst
     body.body_limit(kMaxResponseBody);
     body.get().body().open(partial.c_str(), beast::file_mode::write, ec);
     if (ec) throw std::runtime_error("cannot write " + partial + ": " + ec.message());
-    http::read(stream, buffer, body, ec);
+    ec = readWithin(ioc, stream, buffer, body, timeout_);
     body.get().body().close();
     if (ec) {
       std::filesystem::remove(partial);
-      throw ConnectionError("download from " + server_ + " broke off: " + ec.message());
+      throw ConnectionError("download from " + server_ + " broke off: " + failure(ec, timeout_));
     }
     std::filesystem::rename(partial, file);
   } else {
     http::response_parser<http::string_body> body(std::move(header));
-    http::read(stream, buffer, body, ec);
+    ec = readWithin(ioc, stream, buffer, body, timeout_);
     out.body = body.get().body();
   }
   stream.socket().shutdown(tcp::socket::shutdown_both, ec);

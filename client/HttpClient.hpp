@@ -3,6 +3,7 @@
 /// A small synchronous HTTP/1.1 client (Boost.Beast) for the rcfd client: one connection per
 /// request, bearer token, JSON bodies, streamed file uploads and downloads.
 
+#include <chrono>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -28,7 +29,8 @@ struct HttpResponse {
 class HttpClient {
  public:
   /// `server` like "http://127.0.0.1:8080" (http only); throws std::invalid_argument otherwise.
-  HttpClient(const std::string& server, std::string token);
+  /// Connecting, and each send or receive after it, fails with ConnectionError after `timeout`.
+  HttpClient(const std::string& server, std::string token, std::chrono::seconds timeout = std::chrono::seconds(60));
 
   HttpResponse get(const std::string& target);
   HttpResponse post(const std::string& target, const std::string& jsonBody,
@@ -42,6 +44,7 @@ class HttpClient {
 
  private:
   std::string server_, host_, port_, token_;
+  std::chrono::seconds timeout_;
 };
 
 }  // namespace rcfd::client

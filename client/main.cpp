@@ -163,6 +163,9 @@ int main(int argc, char** argv) {
   std::string token = envOr("RCFD_TOKEN", "");
   app.add_option("--server", server, "server URL (env RCFD_SERVER)")->capture_default_str();
   app.add_option("--token", token, "bearer token (env RCFD_TOKEN)");
+  int timeoutSeconds = std::atoi(envOr("RCFD_TIMEOUT", "60").c_str());
+  app.add_option("--timeout", timeoutSeconds, "seconds to wait for the server to connect or answer (env RCFD_TIMEOUT)")
+      ->capture_default_str()->check(CLI::Range(1, 86400));
   app.require_subcommand(1);
 
   std::string file, id, name, output, state, kind, key, format = "csv";
@@ -211,7 +214,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    HttpClient client(server, token);
+    HttpClient client(server, token, std::chrono::seconds(std::max(1, timeoutSeconds)));
     if (submit->parsed()) {
       const json body = readJobFile(file);
       std::map<std::string, std::string> headers;

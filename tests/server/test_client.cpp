@@ -22,6 +22,7 @@ Run runClient(std::vector<std::string> args, const std::vector<std::string>& env
   const auto outPath = capture.path() / "out", errPath = capture.path() / "err";
   const pid_t pid = ::fork();
   if (pid == 0) {
+    ::alarm(60);  // a client that hangs is killed (and its test fails) instead of hanging the suite
     ::unsetenv("RCFD_SERVER");
     ::unsetenv("RCFD_TOKEN");
     for (const auto& e : env) ::putenv(const_cast<char*>(e.c_str()));
@@ -95,6 +96,18 @@ TEST_F(Client, SubmitStatusJobsCancel) {
   const auto wait = runClient({"wait", id}, env());
   EXPECT_EQ(wait.code, 1);
   EXPECT_NE(wait.err.find("CANCELLED"), std::string::npos);
+}
+
+TEST_F(Client, AServerThatStopsAnsweringTimesTheClientOutInsteadOfHangingIt) {
+  ::kill(server_->pid(), SIGSTOP);  // connections still complete in the kernel; nothing answers
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto jobs = runClient({"--timeout", "2", "jobs"}, env());
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ::kill(server_->pid(), SIGCONT);
+  EXPECT_EQ(jobs.code, 1) << jobs.err;
+  EXPECT_NE(jobs.err.find("no answer within 2 s"), std::string::npos) << jobs.err;
+  EXPECT_LT(waited, 10.0);
+  EXPECT_EQ(runClient({"jobs"}, env()).code, 0);  // answering again
 }
 
 TEST_F(Client, FlagsOverrideEnvironmentAndIdempotencyKeyIsSent) {
