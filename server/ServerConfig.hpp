@@ -23,6 +23,7 @@ struct ServerConfig {
   int maxConnectionsPerPeer = 512;                   ///< open connections from one address (a proxy counts as one)
   std::chrono::seconds uploadTimeout{3600};          ///< whole-upload timeout
   std::chrono::seconds shutdownGrace{120};           ///< wait for solvers to checkpoint on stop
+  std::chrono::seconds cancelGrace{30};              ///< a cancelled solver still running after this is killed
 
   std::filesystem::path jobDir(const std::string& id) const { return dataDir / "jobs" / id; }
   std::filesystem::path databaseDir() const { return dataDir / "databases"; }

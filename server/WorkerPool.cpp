@@ -1,5 +1,6 @@
 #include "WorkerPool.hpp"
 
+#include <poll.h>
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
@@ -111,7 +112,9 @@ int WorkerPool::busy() {
 void WorkerPool::terminate(const std::string& id) {
   std::lock_guard lock(mutex_);
   auto it = children_.find(id);
-  if (it != children_.end()) ::kill(it->second, SIGTERM);
+  if (it == children_.end()) return;
+  ::kill(it->second, SIGTERM);
+  cancelSent_.emplace(id, std::chrono::steady_clock::now());
 }
 
 bool WorkerPool::isRunnable(JobRecord& job) {
@@ -170,6 +173,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
   const fs::path log = dir / "solver.log";
   std::streamoff logStart = 0;
   int waitStatus = -1;
+  bool killedAfterCancel = false;
   std::string setupError;
   try {
     fs::create_directories(dir);
@@ -262,7 +266,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       children_[job.id] = pid;
     }
     // Cancel or shutdown may have come between markStarted and the fork.
-    if (auto now = store_.job(job.id); now && now->state == state::cancelling) ::kill(pid, SIGTERM);
+    if (auto now = store_.job(job.id); now && now->state == state::cancelling) terminate(job.id);
     {
       std::lock_guard lock(mutex_);
       if (stopping_) ::kill(pid, SIGTERM);
@@ -272,6 +276,18 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
     auto lastWrite = std::chrono::steady_clock::now() - kProgressWriteInterval;
     nlohmann::json latest;
     for (;;) {
+      // Wake at least once a second: a solver that ignores its cancel is killed after the grace period.
+      pollfd ready{pipeFds[0], POLLIN, 0};
+      if (::poll(&ready, 1, 1000) == 0) {
+        std::lock_guard lock(mutex_);
+        const auto sent = cancelSent_.find(job.id);
+        if (!killedAfterCancel && sent != cancelSent_.end() &&
+            std::chrono::steady_clock::now() - sent->second > config_.cancelGrace) {
+          ::kill(pid, SIGKILL);
+          killedAfterCancel = true;
+        }
+        continue;
+      }
       const ssize_t n = ::read(pipeFds[0], chunk, sizeof chunk);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) break;
@@ -300,13 +316,14 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
     }
     std::lock_guard lock(mutex_);
     children_.erase(job.id);
+    cancelSent_.erase(job.id);
   }
 
   if (!setupError.empty()) {
     if (!store_.transition(job.id, state::running, state::failed, {}, setupError))
       store_.transition(job.id, state::cancelling, state::cancelled, "cancelled before start");
   } else {
-    finishJob(job, waitStatus, logTail(log, logStart));
+    finishJob(job, waitStatus, logTail(log, logStart), killedAfterCancel);
   }
   {
     std::lock_guard lock(mutex_);
@@ -316,7 +333,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
   wake_.notify_all();
 }
 
-void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail) {
+void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail, bool killedAfterCancel) {
   bool stopping;
   {
     std::lock_guard lock(mutex_);
@@ -366,6 +383,12 @@ void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::stri
     const int sig = WTERMSIG(waitStatus);
     if (stopping && !cancelling && sig == SIGTERM) {
       store_.transition(job.id, from, state::queued, "server shut down before the solver checkpointed");
+      return;
+    }
+    if (killedAfterCancel) {
+      store_.transition(job.id, from, state::cancelled,
+                        "the solver did not stop within " + std::to_string(config_.cancelGrace.count()) +
+                            " s of the cancel and was killed (SIGKILL); its checkpoint, if any, is kept");
       return;
     }
     store_.transition(job.id, from, cancelling ? state::cancelled : state::failed, {},

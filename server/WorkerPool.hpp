@@ -7,6 +7,7 @@
 /// only its job. Children get SIGTERM if the server dies (PR_SET_PDEATHSIG), so they checkpoint and the
 /// restarted server resumes them from the same out directory.
 
+#include <chrono>
 #include <condition_variable>
 #include <map>
 #include <mutex>
@@ -44,7 +45,7 @@ class WorkerPool {
  private:
   void schedulerLoop();
   void runJob(JobRecord job, std::uint64_t run);
-  void finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail);
+  void finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail, bool killedAfterCancel);
   bool isRunnable(JobRecord& job);
 
   JobStore& store_;
@@ -55,6 +56,8 @@ class WorkerPool {
   bool stopping_ = false;
   bool pending_ = false;
   std::map<std::string, pid_t> children_;
+  /// When each running job's cancel was sent (SIGTERM): past config.cancelGrace its solver is killed.
+  std::map<std::string, std::chrono::steady_clock::time_point> cancelSent_;
   std::map<std::uint64_t, std::thread> threads_;  // by run number (a re-queued job runs again)
   std::vector<std::uint64_t> finished_;
   std::uint64_t runs_ = 0;

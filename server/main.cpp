@@ -110,6 +110,9 @@ int main(int argc, char** argv) {
   app.add_option("--max-body-bytes", maxBody, "limit of a JSON request body")->capture_default_str();
   app.add_option("--max-upload-bytes", maxUpload, "limit of a database upload")->capture_default_str();
   app.add_option("--shutdown-grace", graceSeconds, "seconds solvers get to checkpoint on shutdown")->capture_default_str();
+  int cancelGrace = static_cast<int>(config.cancelGrace.count());
+  app.add_option("--cancel-grace", cancelGrace, "seconds a cancelled solver gets to checkpoint before it is killed")
+      ->capture_default_str()->check(CLI::Range(1, 86400));
   int idleBeforeToken = static_cast<int>(config.idleBeforeToken.count());
   app.add_option("--idle-before-token", idleBeforeToken,
                  "seconds a connection may wait for its first request with a token before it is closed")
@@ -132,6 +135,7 @@ int main(int argc, char** argv) {
     config.uploadLimit = maxUpload;
     config.shutdownGrace = std::chrono::seconds(graceSeconds);
     config.idleBeforeToken = std::chrono::seconds(idleBeforeToken);
+    config.cancelGrace = std::chrono::seconds(cancelGrace);
     // Connections beyond the descriptor limit would make accept fail: keep 64 for SQLite, logs, solvers.
     if (rlimit files{}; maxConnections->count() == 0 && ::getrlimit(RLIMIT_NOFILE, &files) == 0 &&
                         files.rlim_cur != RLIM_INFINITY)

@@ -338,6 +338,32 @@ TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   EXPECT_TRUE(requeued) << events.dump(2);
 }
 
+// A solver that ignores its cancel (SIGTERM) is killed after --cancel-grace and the job ends CANCELLED
+// with the reason. rcfd-solve itself stops on SIGTERM, so the hung solver is a script that ignores the
+// signal and sleeps: the one misbehaving child this server's own solver cannot be made to be.
+TEST_F(EndToEnd, ASolverThatIgnoresItsCancelIsKilledAfterTheGracePeriod) {
+  const auto hung = tmp_->path() / "hung-solver.sh";
+  std::ofstream(hung) << "#!/bin/sh\ntrap '' TERM\nexec sleep 600\n";
+  std::filesystem::permissions(hung, std::filesystem::perms::owner_all);
+  ServerProcess server(tmp_->path() / "data", "e2e-token",
+                       {"--workers", "1", "--solver", hung.string(), "--cancel-grace", "1"});
+  const std::string id = submit(server, databaseJob(5));
+  ASSERT_EQ(pollJob(server, id, [](const nlohmann::json& j) { return j.at("state") == "RUNNING"; }).at("state"),
+            "RUNNING");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the script has set its trap
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(server.post("/v1/jobs/" + id + ":cancel", "").status, 202);
+  const auto done = pollJob(server, id, isFinal);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(done.at("state"), "CANCELLED") << done.dump(2);
+  EXPECT_LT(waited, 5.0);
+  EXPECT_GT(waited, 0.9);
+  const auto events = server.get("/v1/jobs/" + id + "/events").json().at("events");
+  bool killed = false;
+  for (const auto& e : events) killed = killed || e.at("reason").get<std::string>().find("SIGKILL") != std::string::npos;
+  EXPECT_TRUE(killed) << events.dump(2);
+}
+
 // The cancel arrives as soon as the job is RUNNING, which is often before the solver child has
 // exec'd. It used to inherit the server's Asio SIGTERM handler there and shut the server down (the
 // "connection reset by peer" this test saw under load): the server must keep serving and the job end
