@@ -71,7 +71,7 @@ inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, c
   if (!token.empty()) req.set(http::field::authorization, "Bearer " + token);
   for (const auto& [k, v] : headers) req.set(k, v);
   if (!body.empty() || method == http::verb::post) {
-    req.set(http::field::content_type, "application/json");
+    if (!headers.count("Content-Type")) req.set(http::field::content_type, "application/json");
     req.body() = body;
   }
   req.prepare_payload();

@@ -66,6 +66,22 @@ TEST_F(Api, InvalidJsonIs400) {
   expectStillServing();
 }
 
+TEST_F(Api, HealthWithATrailingSlashNeedsNoTokenEither) {
+  const auto r = httpRequest(server_->port(), http::verb::get, "/v1/health/");
+  EXPECT_EQ(r.status, 200) << r.body;
+  EXPECT_EQ(r.json().at("status"), "ok");
+}
+
+TEST_F(Api, AJobThatIsNotSentAsJsonIs415) {
+  for (const std::string type : {"application/x-www-form-urlencoded", "text/plain"}) {
+    const auto r = server_->post("/v1/jobs", databaseJob().dump(), {{"Content-Type", type}});
+    expectProblem(r, 415);
+    EXPECT_NE(r.json().at("detail").get<std::string>().find(type), std::string::npos) << r.body;
+  }
+  const auto ok = server_->post("/v1/jobs", databaseJob().dump(), {{"Content-Type", "application/json; charset=utf-8"}});
+  EXPECT_EQ(ok.status, 202) << ok.body;
+}
+
 TEST_F(Api, ANumberBeyondDoubleRangeIs400) {
   auto job = databaseJob();
   job.erase("seed");
