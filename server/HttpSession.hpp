@@ -22,7 +22,7 @@ namespace rcfd::server {
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  /// `ticket` is held for the session's lifetime (the listener's count of open connections).
+  /// `ticket` is held as long as the connection is open (the listener's count of open connections).
   HttpSession(boost::asio::ip::tcp::socket&& socket, Router& router, boost::asio::thread_pool& blocking,
               std::shared_ptr<void> ticket = {});
   ~HttpSession();

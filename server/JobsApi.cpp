@@ -110,6 +110,16 @@ nlohmann::json JobsApi::toJson(const JobRecord& job, bool withRequest) const {
 }
 
 Response JobsApi::submit(const Request& req, const Target& target) {
+  // A job is JSON: a form or text body is refused before it is parsed.
+  const auto type = req.find(http::field::content_type);
+  std::string_view media = type == req.end() ? std::string_view() : std::string_view(type->value().data(), type->value().size());
+  const std::string_view sent = media.substr(0, 100);
+  media = media.substr(0, media.find(';'));
+  while (!media.empty() && media.back() == ' ') media.remove_suffix(1);
+  if (!boost::beast::iequals(boost::beast::string_view(media.data(), media.size()), "application/json"))
+    return problem(http::status::unsupported_media_type, "unsupported-media-type", "Unsupported media type",
+                   "a job is sent as \"Content-Type: application/json\" (got \"" + std::string(sent) + "\")",
+                   target.path);
   nlohmann::json document;
   try {
     document = nlohmann::json::parse(req.body());
@@ -131,7 +141,8 @@ Response JobsApi::submit(const Request& req, const Target& target) {
   // The solver opens a file a scene names as the server's user: a job could read any file the server
   // can (its first word lands in the job's error). No such field is taken, inline or patched.
   const nlohmann::json scene = sceneToJson(spec.scene);
-  for (const std::string& pointer : SchemaValidator::get("scene").filePathPointers()) {
+  static const std::vector<std::string> filePaths = SchemaValidator::get("scene").filePathPointers();
+  for (const std::string& pointer : filePaths) {
     const nlohmann::json::json_pointer at(pointer);
     if (scene.contains(at) && scene[at].is_string() && !scene[at].get<std::string>().empty())
       return invalidInput(InputError("job", "/scene" + pointer,

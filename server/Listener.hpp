@@ -34,7 +34,7 @@ class Listener : public std::enable_shared_from_this<Listener> {
  private:
   void doAccept();
   void onAccept(boost::system::error_code ec, boost::asio::ip::tcp::socket socket);
-  /// A ticket for a new connection from `peer`, released when the session ends; null over a cap.
+  /// A ticket for a new connection from `peer`, released when the connection closes; null over a cap.
   std::shared_ptr<void> admit(const std::string& peer);
   /// One stderr line, unless one was written less than 10 s ago (then it is counted and summarised).
   void logLimited(const std::string& line);

@@ -128,19 +128,7 @@ Response Router::route(const Request& req, const Target& target) {
   }
   if (s.size() >= 2 && s[1] == "jobs") {
     if (s.size() == 2) {
-      if (post) {
-        // A job is JSON: a form or text body is refused before it is parsed.
-        const auto type = req.find(http::field::content_type);
-        const std::string_view value = type == req.end() ? std::string_view() : std::string_view(type->value().data(), type->value().size());
-        auto media = value.substr(0, value.find(';'));
-        while (!media.empty() && media.back() == ' ') media.remove_suffix(1);
-        if (!boost::beast::iequals(boost::beast::string_view(media.data(), media.size()), "application/json"))
-          return problem(http::status::unsupported_media_type, "unsupported-media-type", "Unsupported media type",
-                         "a job is sent as \"Content-Type: application/json\" (got \"" +
-                             std::string(value.substr(0, 100)) + "\")",
-                         target.path);
-        return jobs_.submit(req, target);
-      }
+      if (post) return jobs_.submit(req, target);
       if (get) return jobs_.list(target);
       return methodNotAllowed(target, "GET, POST");
     }
