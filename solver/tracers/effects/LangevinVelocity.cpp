@@ -3,17 +3,25 @@
 // slow, and tracers moving with it linger where the particles shoot through (long spray-zone stays,
 // too few crossings); the variance of the particle velocities about that mean (/frames/u_p_variance,
 // the granular temperature per component, at the scale of the mean) says how fast they really move.
-// Every tracer carries a fluctuation u' (per component d, variance sigma_d^2 of its cell in the step's
-// frame), integrated exactly over the step for constant coefficients:
-//   u'_d <- a u'_d + (1 - a) T g_d + sigma_d sqrt(1 - a^2) xi,   a = exp(-dt / T),
-// with T the kinetic-theory time between collisions (at most rcfd.langevin_time), xi standard normal
-// (NormalTable, from a counter-based stream per tracer and step), and the drift g_d = d(alpha_P sigma_d^2)/dx_d / alpha_P: in the diffusive limit the tracer flux is then
-// -T grad(sigma^2 n) + n T g, which vanishes for n proportional to alpha_P^rec, so the fluctuation
-// does not move tracers out of where the recurrence field puts them (the well-mixed condition of
-// Thomson 1987, in its mean-drift form). |T g| is capped at rcfd.u_fluc_max. u' is added to Eq. (9)
-// over the step (TracerContext::streamVelocity, after velocity_streams and directed_relaxation when
-// those are listed). The step's coefficients a, sigma_d sqrt(1 - a^2) and (1 - a) T g_d are computed per
-// cell and interpolated trilinearly to the tracer.
+//
+// Every tracer carries a fluctuation u' (per component d: variance sigma_d^2 of its cell in the step's
+// frame, memory T, mean mu_d), and the OU process is integrated exactly over the step for coefficients
+// held over it, velocity and displacement together (Gillespie 1996):
+//   u'_d(t + dt) = mu_d + a (u'_d - mu_d) + sigma_d s xi1,                       a = exp(-dt / T),
+//   w_d          = mu_d + b (u'_d - mu_d) + sigma_d (c1 xi1 + c2 xi2) / dt,      b = T (1 - a) / dt,
+// where w is the mean fluctuation over the step (the displacement over dt), s^2 = 1 - a^2, and c1, c2
+// give the displacement its variance T^2 (2 dt/T - 3 + 4a - a^2) and its covariance T (1 - a)^2 with the
+// end velocity; xi1, xi2 standard normal (NormalTable, from a counter-based stream per tracer and step).
+// w, not the end velocity, is added to Eq. (9) over the step (TracerContext::streamVelocity, after
+// velocity_streams and directed_relaxation when those are listed): where T is far below dt (a dense bed
+// forgets a fluctuation between two collisions) a tracer then diffuses with sigma^2 T, as the particles
+// do, not with sigma^2 dt / 2.
+// T is the kinetic-theory time between collisions (at most rcfd.langevin_time). The mean
+// mu_d = d(alpha_P K_d)/dx_d / alpha_P, K_d = sigma_d^2 T, capped at rcfd.u_fluc_max, is the
+// well-mixed condition (Thomson 1987) in its mean-drift form: in the diffusive limit the tracer flux is
+// -grad(K n) + n mu, which vanishes for n proportional to alpha_P^rec, so the fluctuation does not move
+// tracers out of where the recurrence field puts them. The step's coefficients are computed per cell
+// and interpolated trilinearly to the tracer.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -25,6 +33,7 @@
 #include "core/Permutation.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/NormalTable.hpp"
+#include "tracers/OrnsteinUhlenbeckStep.hpp"
 #include "tracers/TracerEffect.hpp"
 #include "tracers/Trilinear.hpp"
 
@@ -52,15 +61,17 @@ class LangevinVelocityEffect final : public TracerEffect {
     sigma_.assign(3 * std::size_t(cells), 0.0f);
     coefficients_.assign(kCoefficients * std::size_t(cells), 0.0f);
     diameter_ = ctx.scene.particles.diameter;
-    drift_.assign(3 * std::size_t(cells), 0.0f);
     moment_.assign(std::size_t(cells), 0.0);
+    memory_.assign(std::size_t(cells), 0.0);
+    steps_.assign(std::size_t(cells), OrnsteinUhlenbeckStep{});
     alpha_.assign(std::size_t(cells), 0.0);
   }
 
   std::size_t allocatedBytes() const override {
     return (owner_ ? 3 * tracers_ * sizeof(float) : 0) + 3 * tracers_ * sizeof(float) +
-           (sigma_.capacity() + drift_.capacity() + coefficients_.capacity()) * sizeof(float) +
-           (moment_.capacity() + alpha_.capacity()) * sizeof(double);
+           (sigma_.capacity() + coefficients_.capacity()) * sizeof(float) +
+           (moment_.capacity() + alpha_.capacity() + memory_.capacity()) * sizeof(double) +
+           steps_.capacity() * sizeof(OrnsteinUhlenbeckStep);
   }
 
   void beforeMove(TracerContext& ctx) override {
@@ -103,15 +114,20 @@ class LangevinVelocityEffect final : public TracerEffect {
         const float* cell = coefficients + kCoefficients * (base + std::size_t(corner[k]));
         for (int q = 0; q < kCoefficients; ++q) at[q] += w * double(cell[q]);
       }
-      double xi[3];
+      double xi1[3], xi2[3];
       CounterRng rng(prefix, std::uint64_t(id[i]));
-      normals.three(rng.nextU64(), xi);
-      Eigen::Vector3d next;
-      for (int d = 0; d < 3; ++d) next[d] = at[0] * double(u[d][i]) + at[4 + d] + at[1 + d] * xi[d];
-      reflectAtWalls(ctx.apparatus, Eigen::Vector3d(position[0][i], position[1][i], position[2][i]), ctx.dt, next);
+      normals.three(rng.nextU64(), xi1);
+      normals.three(rng.nextU64(), xi2);
+      Eigen::Vector3d next, step;
+      for (int d = 0; d < 3; ++d) {
+        const double mean = at[kMean + d], sigma = at[kSigma + d], deviation = double(u[d][i]) - mean;
+        next[d] = mean + at[kDecay] * deviation + sigma * at[kKick] * xi1[d];
+        step[d] = mean + at[kCarry] * deviation + sigma * (at[kShared] * xi1[d] + at[kOwn] * xi2[d]);
+      }
+      reflectAtWalls(ctx.apparatus, Eigen::Vector3d(position[0][i], position[1][i], position[2][i]), ctx.dt, step, next);
       for (int d = 0; d < 3; ++d) {
         u[d][i] = float(next[d]);
-        out[d][i] = owner ? float(next[d]) : out[d][i] + float(next[d]);
+        out[d][i] = owner ? float(step[d]) : out[d][i] + float(step[d]);
       }
     }
   }
@@ -144,11 +160,13 @@ class LangevinVelocityEffect final : public TracerEffect {
 
  private:
   /// A fluctuation that would carry the tracer through a wall or plate within the step is reflected
-  /// at it, as a particle's velocity is: the walls reflect the tracer's position, and a fluctuation
-  /// kept pointing into the wall for the time scale T would hold tracers against it. Most tracers are
-  /// cleared by the convex half-spaces and the plates' boxes alone.
-  void reflectAtWalls(const Apparatus& apparatus, const Eigen::Vector3d& p, double dt, Eigen::Vector3d& u) const {
-    const Eigen::Vector3d q = p + dt * u;
+  /// at it, as a particle's velocity is, and so is the fluctuation carried on where it points into that
+  /// wall: the walls reflect the tracer's position, and a fluctuation kept pointing into the wall for
+  /// the time scale T would hold tracers against it. Most tracers are cleared by the convex
+  /// half-spaces and the plates' boxes alone.
+  void reflectAtWalls(const Apparatus& apparatus, const Eigen::Vector3d& p, double dt, Eigen::Vector3d& step,
+                      Eigen::Vector3d& carried) const {
+    const Eigen::Vector3d q = p + dt * step;
     bool clear = true;
     for (const auto& h : halfSpaces_) clear = clear && h.n.dot(q) - h.c >= margin_;
     for (const auto& b : plates_) {
@@ -160,11 +178,14 @@ class LangevinVelocityEffect final : public TracerEffect {
     if (clear || apparatus.signedDistance(p) < -apparatus.boundaryTolerance()) return;
     const auto hit = apparatus.firstIntersection(p, q);
     if (!hit) return;
-    const double into = u.dot(hit->normal);
-    if (into < 0.0) u -= 2.0 * into * hit->normal;
+    const double into = step.dot(hit->normal);
+    if (into >= 0.0) return;
+    step -= 2.0 * into * hit->normal;
+    const double carriedInto = carried.dot(hit->normal);
+    if (carriedInto < 0.0) carried -= 2.0 * carriedInto * hit->normal;
   }
 
-  /// sigma_d and the drift T g_d of every cell for this step's frame (blended like alpha_P^rec).
+  /// The coefficients of every cell for this step's frame (blended like alpha_P^rec).
   void cellFields(const TracerContext& ctx) {
     const FieldFrame& a = *ctx.frame;
     const FieldFrame* b = ctx.nextFrame.get();
@@ -175,52 +196,70 @@ class LangevinVelocityEffect final : public TracerEffect {
       return fb ? (1.0 - blend) * double(fa[k]) + blend * double((*fb)[k]) : double(fa[k]);
     };
     for (std::size_t c = 0; c < cells; ++c) alpha_[c] = ctx.openVolume[c] > 0.0 ? mix(a.alpha_p, b ? &b->alpha_p : nullptr, c) : 0.0;
-    for (int d = 0; d < 3; ++d) {
-      for (std::size_t c = 0; c < cells; ++c) {
-        const double variance = std::max(0.0, mix(a.u_p_variance, b ? &b->u_p_variance : nullptr, 3 * c + std::size_t(d)));
-        sigma_[3 * c + std::size_t(d)] = float(std::sqrt(variance));
-        moment_[c] = alpha_[c] * variance;
-      }
-      const double h = grid.spacing[d];
-      for (std::size_t c = 0; c < cells; ++c) {
-        double g = 0.0;
-        if (alpha_[c] > 0.0) {
-          const auto ijk = grid.cellIjk(std::int64_t(c));
-          auto neighbour = [&](int side) -> std::int64_t {
-            auto nb = ijk;
-            nb[std::size_t(d)] += side;
-            if (nb[std::size_t(d)] < 0 || nb[std::size_t(d)] >= grid.shape[std::size_t(d)]) return -1;
-            const std::int64_t o = grid.flatIndex(nb[0], nb[1], nb[2]);
-            return ctx.openVolume[std::size_t(o)] > 0.0 ? o : -1;
-          };
-          const std::int64_t lo = neighbour(-1), hi = neighbour(1);
-          const double fLo = lo >= 0 ? moment_[std::size_t(lo)] : moment_[c];
-          const double fHi = hi >= 0 ? moment_[std::size_t(hi)] : moment_[c];
-          const double span = double((lo >= 0) + (hi >= 0)) * h;
-          if (span > 0.0) g = (fHi - fLo) / span / alpha_[c];
-        }
-        drift_[3 * c + std::size_t(d)] = float(g);
-      }
-    }
-    // The memory: the time between collisions of kinetic theory, d sqrt(pi) / (24 alpha_P g0 sqrt(theta))
-    // with the Carnahan-Starling g0 and theta the mean of the three variances, at most rcfd.langevin_time
-    // (the dilute limit, where drag and walls end the memory). Then the exact OU step's coefficients.
     for (std::size_t c = 0; c < cells; ++c) {
-      const double a = std::min(alpha_[c], 0.6);
-      const double theta = (double(sigma_[3 * c]) * sigma_[3 * c] + double(sigma_[3 * c + 1]) * sigma_[3 * c + 1] +
-                            double(sigma_[3 * c + 2]) * sigma_[3 * c + 2]) / 3.0;
-      const double g0 = (1.0 - 0.5 * a) / std::pow(1.0 - a, 3);
-      const double rate = 24.0 * a * g0 * std::sqrt(theta) / (diameter_ * std::sqrt(std::numbers::pi));
-      const double memory = rate * time_ > 1.0 ? 1.0 / rate : time_;
-      const double decay = std::exp(-ctx.dt / memory);
-      const double kick = std::sqrt(std::max(0.0, 1.0 - decay * decay));
-      float* k = coefficients_.data() + kCoefficients * c;
-      k[0] = float(decay);
-      for (int d = 0; d < 3; ++d) {
-        k[1 + d] = float(double(sigma_[3 * c + std::size_t(d)]) * kick);
-        k[4 + d] = float((1.0 - decay) * std::clamp(memory * double(drift_[3 * c + std::size_t(d)]), -cap_, cap_));
+      double theta = 0.0;
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double variance = std::max(0.0, mix(a.u_p_variance, b ? &b->u_p_variance : nullptr, 3 * c + d));
+        sigma_[3 * c + d] = float(std::sqrt(variance));
+        theta += variance / 3.0;
+      }
+      memory_[c] = memory(alpha_[c], theta);
+    }
+    for (std::size_t c = 0; c < cells; ++c) steps_[c] = OrnsteinUhlenbeckStep::over(ctx.dt, memory_[c]);
+    for (std::size_t d = 0; d < 3; ++d) {
+      for (std::size_t c = 0; c < cells; ++c) moment_[c] = alpha_[c] * double(sigma_[3 * c + d]) * sigma_[3 * c + d];
+      for (std::size_t c = 0; c < cells; ++c) {
+        double mean = 0.0;
+        if (alpha_[c] > 0.0) {
+          // The well-mixed mean: T d(alpha sigma^2)/dx / alpha, and where the step forgets the velocity
+          // (carry -> 0) the part sigma^2 dT/dx that coefficients frozen over the step at its start
+          // would otherwise lose, so that (alpha sigma^2 T)' / alpha in the diffusive limit.
+          const double gradMoment = centralDifference(ctx, moment_, c, d);
+          const double gradMemory = centralDifference(ctx, memory_, c, d);
+          mean = memory_[c] * gradMoment / alpha_[c] +
+                 (1.0 - steps_[c].carry) * moment_[c] / alpha_[c] * gradMemory;
+          mean = std::clamp(mean, -cap_, cap_);
+        }
+        coefficients_[kCoefficients * c + kMean + d] = float(mean);
+        coefficients_[kCoefficients * c + kSigma + d] = sigma_[3 * c + d];
       }
     }
+    for (std::size_t c = 0; c < cells; ++c) {
+      const OrnsteinUhlenbeckStep& step = steps_[c];
+      float* k = coefficients_.data() + kCoefficients * c;
+      k[kDecay] = float(step.decay);
+      k[kKick] = float(step.kick);
+      k[kCarry] = float(step.carry);
+      k[kShared] = float(step.shared);
+      k[kOwn] = float(step.own);
+    }
+  }
+
+  /// d f / dx_d at cell c from its open neighbours along d (one-sided at walls, 0 without any).
+  static double centralDifference(const TracerContext& ctx, const std::vector<double>& f, std::size_t c, std::size_t d) {
+    const CartesianGrid& grid = ctx.grid;
+    const auto ijk = grid.cellIjk(std::int64_t(c));
+    auto neighbour = [&](int side) -> std::int64_t {
+      auto nb = ijk;
+      nb[d] += side;
+      if (nb[d] < 0 || nb[d] >= grid.shape[d]) return -1;
+      const std::int64_t o = grid.flatIndex(nb[0], nb[1], nb[2]);
+      return ctx.openVolume[std::size_t(o)] > 0.0 ? o : -1;
+    };
+    const std::int64_t lo = neighbour(-1), hi = neighbour(1);
+    const double span = double((lo >= 0) + (hi >= 0)) * grid.spacing[d];
+    if (span <= 0.0) return 0.0;
+    return ((hi >= 0 ? f[std::size_t(hi)] : f[c]) - (lo >= 0 ? f[std::size_t(lo)] : f[c])) / span;
+  }
+
+  /// The memory T: the time between collisions of kinetic theory, d sqrt(pi) / (24 alpha_P g0 sqrt(theta))
+  /// with the Carnahan-Starling g0 and theta the mean of the three variances, at most rcfd.langevin_time
+  /// (the dilute limit, where drag and walls end the memory).
+  double memory(double alpha, double theta) const {
+    const double a = std::min(alpha, 0.6);
+    const double g0 = (1.0 - 0.5 * a) / std::pow(1.0 - a, 3);
+    const double rate = 24.0 * a * g0 * std::sqrt(theta) / (diameter_ * std::sqrt(std::numbers::pi));
+    return rate * time_ > 1.0 ? 1.0 / rate : time_;
   }
 
   double time_, cap_;
@@ -229,13 +268,14 @@ class LangevinVelocityEffect final : public TracerEffect {
   std::size_t tracers_ = 0;
   std::vector<float> fluctuation_[3];  ///< per tracer index: u' [m/s]
   std::vector<float> sigma_;           ///< per cell: sigma_x, sigma_y, sigma_z [m/s]
-  std::vector<float> drift_;           ///< per cell: g_x, g_y, g_z [m/s2]
-  /// Per cell, the exact OU step over dt for the step's frame: a = exp(-dt / T), sigma_d sqrt(1 - a^2)
-  /// and (1 - a) T g_d (capped), padded to 8 floats.
-  static constexpr int kCoefficients = 8;
+  /// Per cell, the exact OU step over dt for the step's frame (OrnsteinUhlenbeckStep's a, s, b, c1 / dt,
+  /// c2 / dt), sigma_d and the mean mu_d (capped), padded to 12 floats.
+  static constexpr int kDecay = 0, kKick = 1, kCarry = 2, kShared = 3, kOwn = 4, kSigma = 5, kMean = 8;
+  static constexpr int kCoefficients = 12;
   std::vector<float> coefficients_;
   double diameter_ = 0.0;              ///< d_P [m]
-  std::vector<double> moment_, alpha_; ///< scratch: alpha_P sigma_d^2 and alpha_P per cell
+  std::vector<double> moment_, alpha_, memory_;  ///< scratch per cell: alpha_P sigma_d^2, alpha_P, T
+  std::vector<OrnsteinUhlenbeckStep> steps_;    ///< scratch per cell: the exact step over dt for T
   struct PlateBox {
     Eigen::Vector2d lo, hi;
   };
