@@ -1,5 +1,5 @@
 // The "database" job (issue 7): the built-in CFD-DEM of the scene sampled into a recurrence field
-// database. Phases, in whole DEM steps (cfddem/DatabaseSchedule.hpp): fill and settle (DEM only), a
+// database. Phases, in whole DEM steps (scene/DatabaseSchedule.hpp): fill and settle (DEM only), a
 // linear ramp of the gas flows, a warm-up at full flow, frames of alpha_P, u_P and u_G (and the velocity
 // spread when a tracer effect of the scene reads it) every dt_rec for
 // sample_duration (appended to DIR/database.h5 as they come), then the reference period. Throughout
@@ -21,7 +21,7 @@
 
 #include "analysis/DatabaseFigures.hpp"
 #include "cfddem/CfdDemSimulation.hpp"
-#include "cfddem/DatabaseSchedule.hpp"
+#include "scene/DatabaseSchedule.hpp"
 #include "cfddem/ReferenceRecorder.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "scene/DatabaseSchedule.hpp"
 #include "scene/SchemaExplainer.hpp"
 
 namespace rcfd {
@@ -138,6 +139,7 @@ std::vector<Violation> checkDatabaseScene(const Scene& s) {
                                             num(chamber) + " m3: at most " +
                                             num(chamber * kDensestRandomPacking * s.particles.density) + " kg fits"});
   }
+  for (auto& v : DatabaseSchedule::violations(s)) out.push_back(std::move(v));
   return out;
 }
 

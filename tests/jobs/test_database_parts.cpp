@@ -16,7 +16,7 @@
 #include "analysis/DatabaseFigures.hpp"
 #include "analysis/SeriesSpectrum.hpp"
 #include "analysis/ZoneStays.hpp"
-#include "cfddem/DatabaseSchedule.hpp"
+#include "scene/DatabaseSchedule.hpp"
 #include "cfddem/DemSystem.hpp"
 #include "cfddem/ReferenceRecorder.hpp"
 #include "core/Errors.hpp"

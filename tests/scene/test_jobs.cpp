@@ -154,6 +154,30 @@ TEST(Jobs, ADatabaseJobWhoseBedCannotFitTheChamberIsRefusedBeforeItStarts) {
   EXPECT_NO_THROW(loadJob({{"kind", "spray"}, {"scene", scene}, {"database", "db.h5"}, {"duration", 1.0}}, "job"));
 }
 
+TEST(Jobs, ADatabaseJobWhoseFramesMissTheDemStepsIsRefusedBeforeItStarts) {
+  // 0.0123 s at 200 Hz is 2.46 frames: the database job's schedule (DatabaseSchedule) refuses it when
+  // it starts, and loading the job (what the server does at submit) refuses it the same way.
+  json scene = quickScene();
+  scene["dem"]["sample_duration"] = 0.0123;
+  try {
+    loadJob({{"kind", "database"}, {"scene", scene}}, "job");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.violations().size(), 1u) << e.what();
+    EXPECT_EQ(e.violations()[0].pointer, "/scene/dem/sample_duration");
+    EXPECT_NE(e.violations()[0].message.find("whole number"), std::string::npos) << e.what();
+  }
+  scene["dem"]["sample_duration"] = 0.015;  // 3 frames
+  EXPECT_NO_THROW(loadJob({{"kind", "database"}, {"scene", scene}}, "job"));
+  scene["dem"]["sample_rate"] = 300.0;  // 133.3 DEM steps of 25 us per frame
+  try {
+    loadJob({{"kind", "database"}, {"scene", scene}}, "job");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations().at(0).pointer, "/scene/dem/sample_rate") << e.what();
+  }
+}
+
 TEST(Jobs, SchemaTextsAreServed) {
   EXPECT_NE(schemaText("scene").find("\"effects\""), std::string::npos);
   EXPECT_NE(schemaText("job").find("\"scene_file\""), std::string::npos);

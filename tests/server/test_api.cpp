@@ -102,6 +102,15 @@ TEST_F(Api, ADatabaseJobWhoseBedCannotFitIsRefusedAtSubmit) {
   EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
 }
 
+TEST_F(Api, ADatabaseJobWhoseScheduleTheSolverWouldRefuseIsRefusedAtSubmit) {
+  auto job = databaseJob();
+  job["scene"]["dem"]["sample_duration"] = 0.0123;  // 2.46 frames at 200 Hz
+  const auto r = server_->post("/v1/jobs", job.dump());
+  expectProblem(r, 422);
+  EXPECT_EQ(r.json().at("errors").at(0).at("pointer"), "/scene/dem/sample_duration") << r.body;
+  EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
+}
+
 TEST_F(Api, SchemaViolationIs422WithPointer) {
   auto job = databaseJob();
   job["kind"] = "teleport";

@@ -6,7 +6,9 @@
 /// periods. Frames and samples fall exactly on DEM steps, so the rates must divide the DEM step.
 
 #include <cstdint>
+#include <vector>
 
+#include "core/Errors.hpp"
 #include "scene/Scene.hpp"
 
 namespace rcfd {
@@ -24,6 +26,9 @@ struct DatabaseSchedule {
   /// field (/dem/sample_rate, /dem/probe_rate, /dem/sample_duration, /dem/reference_duration) and what
   /// is allowed.
   static DatabaseSchedule fromScene(const Scene& scene);
+  /// The same rules as violations (empty when the scene has a schedule): what a database job is
+  /// refused for when it is submitted (checkDatabaseScene).
+  static std::vector<Violation> violations(const Scene& scene);
 
   double dtRec() const { return double(frameSteps) * dtDem; }
   double sampleDt() const { return double(sampleSteps) * dtDem; }
@@ -38,6 +43,9 @@ struct DatabaseSchedule {
   std::int64_t endOffset() const;
   /// Gas flow factor in [0, 1] after `offset` DEM steps since settling: linear over the ramp.
   double flowFactor(std::int64_t offset) const;
+
+ private:
+  static DatabaseSchedule schedule(const Scene& scene, std::vector<Violation>& out);
 };
 
 }  // namespace rcfd

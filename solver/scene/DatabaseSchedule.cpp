@@ -1,4 +1,4 @@
-#include "cfddem/DatabaseSchedule.hpp"
+#include "scene/DatabaseSchedule.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -34,11 +34,23 @@ std::int64_t whole(double x, std::int64_t minimum, const std::string& pointer, c
 
 }  // namespace
 
+std::vector<Violation> DatabaseSchedule::violations(const Scene& scene) {
+  std::vector<Violation> v;
+  schedule(scene, v);
+  return v;
+}
+
 DatabaseSchedule DatabaseSchedule::fromScene(const Scene& scene) {
+  std::vector<Violation> v;
+  DatabaseSchedule s = schedule(scene, v);
+  if (!v.empty()) throw InputError("scene", std::move(v));
+  return s;
+}
+
+DatabaseSchedule DatabaseSchedule::schedule(const Scene& scene, std::vector<Violation>& v) {
   const DemSpec& d = scene.dem;
   DatabaseSchedule s;
   s.dtDem = d.time_step;
-  std::vector<Violation> v;
   s.frameSteps = whole(1.0 / (d.sample_rate * d.time_step), 1, "/dem/sample_rate",
                        "DEM steps per frame 1 / (sample_rate * time_step) = 1 / (" + num(d.sample_rate) + " Hz * " +
                            num(d.time_step) + " s)",
@@ -59,7 +71,6 @@ DatabaseSchedule DatabaseSchedule::fromScene(const Scene& scene) {
                              "reference samples reference_duration * probe_rate = " + num(d.reference_duration) +
                                  " s * " + num(d.probe_rate) + " Hz",
                              v);
-  if (!v.empty()) throw InputError("scene", std::move(v));
   s.rampSteps = std::llround(d.ramp_time / d.time_step);
   s.warmupSteps = std::llround(d.warmup / d.time_step);
   return s;
