@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <thread>
 
 #include "HttpClient.hpp"
@@ -120,11 +121,44 @@ void printStatus(const json& job) {
   }
 }
 
+/// The job's status; while the server cannot be reached or answers that it is unavailable (502, 503,
+/// 504: restarting, or behind a proxy whose backend is), retried with growing pauses for up to
+/// `reconnectSeconds` from the first failure, saying so once on stderr.
+HttpResponse statusAcrossRestarts(HttpClient& client, const std::string& id, double reconnectSeconds) {
+  using Clock = std::chrono::steady_clock;
+  std::optional<Clock::time_point> firstFailure;
+  double pause = 0.25;
+  for (;;) {
+    std::string problem;
+    try {
+      auto res = client.get("/v1/jobs/" + id);
+      if (res.status != 502 && res.status != 503 && res.status != 504) {
+        if (firstFailure) std::cerr << "server " << client.server() << " answers again\n";
+        return res;
+      }
+      problem = "answered " + std::to_string(res.status);
+    } catch (const ConnectionError& e) {
+      problem = e.what();
+    }
+    const auto now = Clock::now();
+    if (!firstFailure) {
+      firstFailure = now;
+      std::cerr << "server " << client.server() << " unreachable (" << problem << "); retrying for up to "
+                << reconnectSeconds << " s\n";
+    }
+    if (std::chrono::duration<double>(now - *firstFailure).count() >= reconnectSeconds)
+      throw ConnectionError(problem + " (gave up after " + std::to_string(int(reconnectSeconds)) +
+                            " s of retries; the job may still be running: rcfd wait " + id + ")");
+    std::this_thread::sleep_for(std::chrono::duration<double>(pause));
+    pause = std::min(2.0 * pause, 5.0);
+  }
+}
+
 /// Polls until the job is final; 0 if it SUCCEEDED.
-int waitFor(HttpClient& client, const std::string& id, double intervalSeconds) {
+int waitFor(HttpClient& client, const std::string& id, double intervalSeconds, double reconnectSeconds) {
   ProgressView view(::isatty(STDERR_FILENO) != 0);  // progress on stderr: stdout stays the job id
   for (;;) {
-    auto res = client.get("/v1/jobs/" + id);
+    auto res = statusAcrossRestarts(client, id, reconnectSeconds);
     if (!res.ok()) fail(res, "status of job " + id);
     const auto job = parseJson(res);
     view.update(job);
@@ -171,7 +205,7 @@ int main(int argc, char** argv) {
   std::string file, id, name, output, state, kind, key, format = "csv";
   bool wait = false, asJson = false;
   int bins = 0;
-  double interval = 1.0;
+  double interval = 1.0, reconnect = 600.0;
 
   auto* submit = app.add_subcommand("submit", "submit a job file (scene_file is inlined)");
   submit->add_option("JOB", file, "job file (CONTRACTS.md)")->required();
@@ -185,8 +219,12 @@ int main(int argc, char** argv) {
   status->add_flag("--json", asJson, "print the job resource as JSON");
   auto* waitCmd = app.add_subcommand("wait", "wait for a job, showing progress and ETA");
   waitCmd->add_option("ID", id)->required();
-  for (auto* sub : {submit, waitCmd})
+  for (auto* sub : {submit, waitCmd}) {
     sub->add_option("--interval", interval, "seconds between polls")->capture_default_str();
+    sub->add_option("--reconnect", reconnect,
+                    "seconds to keep retrying while the server is unreachable (a restart) before giving up")
+        ->capture_default_str()->check(CLI::Range(0.0, 86400.0));
+  }
   auto* cancel = app.add_subcommand("cancel", "cancel a job");
   cancel->add_option("ID", id)->required();
   auto* result = app.add_subcommand("result", "print a succeeded job's summary.json");
@@ -226,7 +264,7 @@ int main(int argc, char** argv) {
       std::cout << jobId << std::endl;
       std::cerr << "submitted " << job.value("kind", "") << " job " << jobId << " ("
                 << job.value("state", "") << ")\n";
-      return wait ? waitFor(client, jobId, interval) : kOk;
+      return wait ? waitFor(client, jobId, interval, reconnect) : kOk;
     }
     if (jobs->parsed()) {
       std::string query = "?page_size=200";
@@ -255,7 +293,7 @@ int main(int argc, char** argv) {
       else printStatus(job);
       return kOk;
     }
-    if (waitCmd->parsed()) return waitFor(client, urlEncode(id), interval);
+    if (waitCmd->parsed()) return waitFor(client, urlEncode(id), interval, reconnect);
     if (cancel->parsed()) {
       auto res = client.post("/v1/jobs/" + urlEncode(id) + ":cancel", "");
       if (!res.ok()) fail(res, "cancel job " + id);

@@ -96,9 +96,11 @@ inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, c
 /// A running rcfd-server child process.
 class ServerProcess {
  public:
-  /// fileLimit > 0: the server runs with at most that many open descriptors (RLIMIT_NOFILE).
+  /// fileLimit > 0: the server runs with at most that many open descriptors (RLIMIT_NOFILE). `listen`
+  /// is its address (port 0: any free port; a restart passes the port of the server it replaces).
   ServerProcess(const std::filesystem::path& dataDir, std::string token,
-                std::vector<std::string> extraArgs = {"--workers", "0"}, int fileLimit = 0)
+                std::vector<std::string> extraArgs = {"--workers", "0"}, int fileLimit = 0,
+                const std::string& listen = "127.0.0.1:0")
       : dataDir_(dataDir), token_(std::move(token)) {
     const auto binary = binaryDir() / "rcfd-server";
     const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
@@ -107,7 +109,7 @@ class ServerProcess {
       out << token_ << "\n";
     }
     std::vector<std::string> args = {binary.string(), "--data-dir", dataDir.string(), "--listen",
-                                     "127.0.0.1:0", "--token-file", tokenFile.string()};
+                                     listen, "--token-file", tokenFile.string()};
     args.insert(args.end(), extraArgs.begin(), extraArgs.end());
     int out[2];
     if (::pipe(out) != 0) throw std::runtime_error("pipe");

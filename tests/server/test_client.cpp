@@ -1,7 +1,11 @@
 // The `rcfd` client against a real server (workers 0: jobs stay QUEUED): submit with scene_file
-// inlining and Idempotency-Key, jobs, status, cancel, and the messages and exit codes of errors.
+// inlining and Idempotency-Key, jobs, status, cancel, wait across a server restart, and the messages
+// and exit codes of errors.
 
 #include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
 
 #include "ServerFixture.hpp"
 
@@ -14,12 +18,31 @@ struct Run {
   std::string out, err;
 };
 
-/// Runs build/rcfd with arguments and extra environment; captures stdout and stderr.
-Run runClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
+/// build/rcfd running in the background with its stdout and stderr captured.
+struct RunningClient {
+  pid_t pid = -1;
+  std::unique_ptr<TempDir> capture = std::make_unique<TempDir>();
+  std::filesystem::path outPath() const { return capture->path() / "out"; }
+  std::filesystem::path errPath() const { return capture->path() / "err"; }
+  /// Waits for it to exit.
+  Run finish() {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    Run r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream o(outPath()), e(errPath());
+    r.out.assign(std::istreambuf_iterator<char>(o), {});
+    r.err.assign(std::istreambuf_iterator<char>(e), {});
+    return r;
+  }
+};
+
+/// Starts build/rcfd with arguments and extra environment.
+RunningClient startClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
   const auto bin = (binaryDir() / "rcfd").string();
   args.insert(args.begin(), bin);
-  TempDir capture;
-  const auto outPath = capture.path() / "out", errPath = capture.path() / "err";
+  RunningClient running;
+  const auto outPath = running.outPath(), errPath = running.errPath();
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::alarm(60);  // a client that hangs is killed (and its test fails) instead of hanging the suite
@@ -36,14 +59,13 @@ Run runClient(std::vector<std::string> args, const std::vector<std::string>& env
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  Run r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream o(outPath), e(errPath);
-  r.out.assign(std::istreambuf_iterator<char>(o), {});
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
+  running.pid = pid;
+  return running;
+}
+
+/// Runs build/rcfd with arguments and extra environment; captures stdout and stderr.
+Run runClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
+  return startClient(std::move(args), env).finish();
 }
 
 std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
@@ -108,6 +130,36 @@ TEST_F(Client, AServerThatStopsAnsweringTimesTheClientOutInsteadOfHangingIt) {
   EXPECT_NE(jobs.err.find("no answer within 2 s"), std::string::npos) << jobs.err;
   EXPECT_LT(waited, 10.0);
   EXPECT_EQ(runClient({"jobs"}, env()).code, 0);  // answering again
+}
+
+TEST_F(Client, WaitKeepsWaitingAcrossAServerRestart) {
+  const std::string id = firstLine(runClient({"submit", (tmp_->path() / "job.json").string()}, env()).out);
+  ASSERT_EQ(id.size(), 32u);
+  auto waiting = startClient({"wait", id, "--interval", "0.2", "--reconnect", "40"}, env());
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  const unsigned short port = server_->port();
+  server_->stop(SIGTERM);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the client finds nobody listening
+  server_ = std::make_unique<ServerProcess>(tmp_->path() / "data", "client-token", std::vector<std::string>{"--workers", "0"},
+                                            0, "127.0.0.1:" + std::to_string(port));
+  ASSERT_EQ(server_->post("/v1/jobs/" + id + ":cancel", "").status, 200);
+  const auto waited = waiting.finish();
+  // The job ended CANCELLED, which the wait reports (exit 1) having waited through the restart.
+  EXPECT_EQ(waited.code, 1) << waited.err;
+  EXPECT_NE(waited.err.find("unreachable"), std::string::npos) << waited.err;
+  EXPECT_NE(waited.err.find("answers again"), std::string::npos) << waited.err;
+  EXPECT_NE(waited.err.find("CANCELLED"), std::string::npos) << waited.err;
+}
+
+TEST_F(Client, WaitGivesUpAfterItsReconnectTimeSayingTheJobMayStillRun) {
+  const std::string id = firstLine(runClient({"submit", (tmp_->path() / "job.json").string()}, env()).out);
+  server_->stop(SIGTERM);
+  const auto started = std::chrono::steady_clock::now();
+  const auto waited = runClient({"wait", id, "--reconnect", "1"}, env());
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(10));
+  EXPECT_EQ(waited.code, 1) << waited.err;
+  EXPECT_NE(waited.err.find("gave up after 1 s"), std::string::npos) << waited.err;
+  EXPECT_NE(waited.err.find("rcfd wait " + id), std::string::npos) << waited.err;
 }
 
 TEST_F(Client, FlagsOverrideEnvironmentAndIdempotencyKeyIsSent) {
