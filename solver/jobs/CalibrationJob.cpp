@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
-#include <set>
 #include <spdlog/spdlog.h>
 #include <thread>
 #ifdef _OPENMP
@@ -87,23 +86,10 @@ class CalibrationJob final : public JobRunner {
     const auto wallStart = std::chrono::steady_clock::now();
     const Scene& scene = job.scene;
     if (job.database.empty()) throw InputError("job", "/database", "a calibration job needs a database");
+    requireJobRules(job);
     const std::int64_t steps = std::llround(job.duration / scene.rcfd.dt);
-    if (steps < 1) throw InputError("job", "/duration", "shorter than one time step rcfd.dt");
     const std::int64_t discardSteps = std::llround(job.discard / scene.rcfd.dt);
-    if (!(job.discard >= 0.0) || discardSteps >= steps) {
-      throw InputError("job", "/discard", std::to_string(job.discard) + " s must be >= 0 and shorter than /duration (" +
-                                              std::to_string(job.duration) + " s)");
-    }
-    if (scene.probes.empty()) {
-      throw InputError("job", "/scene/probes", "a calibration needs at least one probe for the penalty score");
-    }
     std::vector<double> d0 = job.d0_values.empty() ? kDefaultD0 : job.d0_values;
-    std::set<double> seen;
-    for (std::size_t i = 0; i < d0.size(); ++i) {
-      const std::string pointer = "/d0_values/" + std::to_string(i);
-      if (!std::isfinite(d0[i]) || d0[i] < 0.0) throw InputError("job", pointer, "D0 must be finite and >= 0 m2/s");
-      if (!seen.insert(d0[i]).second) throw InputError("job", pointer, "repeats an earlier D0 value");
-    }
     const analysis::SelectionOptions selection = analysis::selectionOptionsFrom(job.source);
     const bool parallelOverD0 = parallelMode(job.source) == "d0_values";
 

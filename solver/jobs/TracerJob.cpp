@@ -66,8 +66,8 @@ class TracerJob final : public JobRunner {
     const Scene& scene = job.scene;
     if (job.database.empty()) throw InputError("job", "/database", "a spray job needs a database");
     const auto wallStart = std::chrono::steady_clock::now();
+    requireJobRules(job);
     const std::int64_t steps = std::llround(job.duration / scene.rcfd.dt);
-    if (steps < 1) throw InputError("job", "/duration", "shorter than one time step rcfd.dt");
 
     // The path is indexed per frame; dt may divide dt_rec, so size it for the number of frames used.
     RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed);

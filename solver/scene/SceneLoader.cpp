@@ -1,9 +1,11 @@
 #include "scene/SceneLoader.hpp"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "core/Errors.hpp"
@@ -146,11 +148,41 @@ JobSpec loadJob(const json& document, const std::string& source, const std::stri
     }
   }
   if (!violations.empty()) throw InputError(source, std::move(violations));
-  if (job.kind == "database") {
-    violations = checkDatabaseScene(job.scene);
-    if (!violations.empty()) throw InputError(source, prefixed(std::move(violations), "/scene"));
-  }
+  violations = jobRuleViolations(job);
+  if (!violations.empty()) throw InputError(source, std::move(violations));
   return job;
+}
+
+std::vector<Violation> jobRuleViolations(const JobSpec& job) {
+  if (job.kind == "database") return prefixed(checkDatabaseScene(job.scene), "/scene");
+  std::vector<Violation> out;
+  if (job.kind != "calibration" && job.kind != "spray") return out;
+  const double dt = job.scene.rcfd.dt;
+  const std::int64_t steps = std::llround(job.duration / dt);
+  if (!(steps >= 1)) {
+    out.push_back({"/duration", std::to_string(job.duration) + " s is shorter than one time step /scene/rcfd/dt (" +
+                                    std::to_string(dt) + " s)"});
+  }
+  if (job.kind != "calibration") return out;
+  if (!(job.discard >= 0.0) || std::llround(job.discard / dt) >= steps) {
+    out.push_back({"/discard", std::to_string(job.discard) + " s must be >= 0 and shorter than /duration (" +
+                                   std::to_string(job.duration) + " s)"});
+  }
+  if (job.scene.probes.empty())
+    out.push_back({"/scene/probes", "a calibration needs at least one probe for the penalty score"});
+  std::set<double> seen;
+  for (std::size_t i = 0; i < job.d0_values.size(); ++i) {
+    const std::string pointer = "/d0_values/" + std::to_string(i);
+    const double d0 = job.d0_values[i];
+    if (!std::isfinite(d0) || d0 < 0.0) out.push_back({pointer, "D0 must be finite and >= 0 m2/s"});
+    else if (!seen.insert(d0).second) out.push_back({pointer, "repeats an earlier D0 value"});
+  }
+  return out;
+}
+
+void requireJobRules(const JobSpec& job) {
+  auto violations = jobRuleViolations(job);
+  if (!violations.empty()) throw InputError("job", std::move(violations));
 }
 
 JobSpec loadJobFile(const std::string& path) {

@@ -7,7 +7,9 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
+#include "core/Errors.hpp"
 #include "scene/Scene.hpp"
 
 namespace rcfd {
@@ -35,6 +37,15 @@ Scene loadSceneText(const std::string& text, const std::string& source = "scene"
 JobSpec loadJob(const nlohmann::json& document, const std::string& source = "job",
                 const std::string& baseDirectory = ".");
 JobSpec loadJobFile(const std::string& path);
+
+/// The rules a job must meet to start, beyond the schemas (pointers into the job document): for a
+/// database job checkDatabaseScene; for calibration and spray jobs /duration at least one rcfd.dt;
+/// for a calibration /discard in [0, /duration), at least one probe (/scene/probes) and D0 values
+/// finite, >= 0 and distinct (/d0_values/i). loadJob refuses a job that breaks them, so the server does
+/// at submit; the jobs check them again at start (requireJobRules) for specs built in code.
+std::vector<Violation> jobRuleViolations(const JobSpec& job);
+/// Throws InputError("job", the violations) if there are any.
+void requireJobRules(const JobSpec& job);
 
 /// The text of an embedded schema by name ("scene", "job"); throws std::out_of_range otherwise.
 const std::string& schemaText(const std::string& name);

@@ -178,6 +178,39 @@ TEST(Jobs, ADatabaseJobWhoseFramesMissTheDemStepsIsRefusedBeforeItStarts) {
   }
 }
 
+TEST(Jobs, CalibrationAndSprayRulesOfTheJobsAreCheckedWhenTheJobIsLoaded) {
+  // What the jobs check at start (requireJobRules), loadJob checks too, so the server refuses it at submit.
+  const json scene = quickScene();  // rcfd.dt = 5 ms
+  auto pointersOf = [](const json& job) {
+    std::vector<std::string> out;
+    try {
+      loadJob(job, "job");
+    } catch (const InputError& e) {
+      for (const auto& v : e.violations()) out.push_back(v.pointer);
+    }
+    return out;
+  };
+  using V = std::vector<std::string>;
+  const json calibration = {{"kind", "calibration"}, {"scene", scene}, {"database", "db.h5"}, {"duration", 2.0}};
+  json job = calibration;
+  job["discard"] = 2.0;
+  EXPECT_EQ(pointersOf(job), V{"/discard"});
+  job["discard"] = 0.5;
+  EXPECT_EQ(pointersOf(job), V{});
+  job["d0_values"] = {0.0, 1e-3, 1e-3};
+  EXPECT_EQ(pointersOf(job), V{"/d0_values/2"});
+  job = calibration;
+  job["discard"] = 0.5;
+  job["scene"]["probes"] = json::array();
+  EXPECT_EQ(pointersOf(job), V{"/scene/probes"});
+  EXPECT_EQ(pointersOf({{"kind", "spray"}, {"scene", scene}, {"database", "db.h5"}, {"duration", 0.001}}),
+            V{"/duration"});
+  // The same rules on a spec built in code, as the jobs apply them.
+  JobSpec spec = loadJob({{"kind", "spray"}, {"scene", scene}, {"database", "db.h5"}, {"duration", 1.0}}, "job");
+  spec.duration = 0.001;
+  EXPECT_THROW(requireJobRules(spec), InputError);
+}
+
 TEST(Jobs, SchemaTextsAreServed) {
   EXPECT_NE(schemaText("scene").find("\"effects\""), std::string::npos);
   EXPECT_NE(schemaText("job").find("\"scene_file\""), std::string::npos);

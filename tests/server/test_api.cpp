@@ -111,6 +111,15 @@ TEST_F(Api, ADatabaseJobWhoseScheduleTheSolverWouldRefuseIsRefusedAtSubmit) {
   EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
 }
 
+TEST_F(Api, ACalibrationJobThatWouldStopAtItsStartIsRefusedAtSubmit) {
+  nlohmann::json job = {{"kind", "calibration"}, {"scene", quickScene()}, {"database", "any"},
+                        {"duration", 2.0}, {"discard", 3.0}};
+  const auto r = server_->post("/v1/jobs", job.dump());
+  expectProblem(r, 422);
+  EXPECT_EQ(r.json().at("errors").at(0).at("pointer"), "/discard") << r.body;
+  EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
+}
+
 TEST_F(Api, SchemaViolationIs422WithPointer) {
   auto job = databaseJob();
   job["kind"] = "teleport";
