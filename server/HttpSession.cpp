@@ -58,20 +58,41 @@ void HttpSession::readError(beast::error_code ec) {
     return;
   }
   started_ = std::chrono::steady_clock::now();
+  const std::string instance = instanceOfFailedRead();
   if (ec == http::error::body_limit) {
     send(problem(http::status::payload_too_large, "body-too-large", "Request body too large",
-                 "the body exceeds the limit of this endpoint", ""),
+                 "the body exceeds the limit of this endpoint", instance),
          false);
     return;
   }
   if (ec == http::error::header_limit) {
     send(problem(http::status::request_header_fields_too_large, "header-too-large",
-                 "Request header too large", "the header exceeds 16 KiB", ""),
+                 "Request header too large", "the header exceeds 16 KiB", instance),
          false);
     return;
   }
-  send(problem(http::status::bad_request, "malformed-http", "Malformed HTTP request", ec.message(), ""),
+  send(problem(http::status::bad_request, "malformed-http", "Malformed HTTP request", ec.message(), instance),
        false);
+}
+
+std::string HttpSession::instanceOfFailedRead() const {
+  // The parser that failed holds the target once it has read the request line. The header is parsed
+  // only when complete, so a header over the limit fails before that: then the target is taken from
+  // the request line still unread in the buffer.
+  std::string_view target;
+  if (body_) target = std::string_view(body_->get().target().data(), body_->get().target().size());
+  else if (upload_) target = std::string_view(upload_->get().target().data(), upload_->get().target().size());
+  else if (header_) target = std::string_view(header_->get().target().data(), header_->get().target().size());
+  if (target.empty()) {
+    const auto unread = buffer_.data();
+    std::string_view requestLine(static_cast<const char*>(unread.data()), unread.size());
+    requestLine = requestLine.substr(0, std::min(requestLine.find('\r'), requestLine.find('\n')));
+    if (const auto space = requestLine.find(' '); space != std::string_view::npos) {
+      target = requestLine.substr(space + 1);
+      target = target.substr(0, target.find(' '));
+    }
+  }
+  return instancePath(target);
 }
 
 void HttpSession::onHeader(beast::error_code ec, std::size_t) {
@@ -81,15 +102,19 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
   tokenSeen_ = tokenSeen_ || req.find(http::field::authorization) != req.end();
   stream_.expires_after(router_.config().readTimeout);  // the body may take the full read time
   const std::string_view target(req.target().data(), req.target().size());
+  const std::string instance = instancePath(target);
+  // Nothing about a request (its size, its body's syntax) is judged for a client without the token:
+  // it gets 401 before its body is read, and the connection closes, discarding that body.
+  if (!Router::isPublic(req.method(), target) && !router_.authorized(req))
+    return send(router_.unauthorized(instance), false);
   const auto tooLarge = [&](std::uint64_t length, std::uint64_t limit) {
     return problem(http::status::payload_too_large, "body-too-large", "Request body too large",
                    "the body has " + std::to_string(length) + " bytes; the limit is " +
                        std::to_string(limit),
-                   std::string(target));
+                   instance);
   };
   const auto length = header_->content_length();
   if (Router::isUpload(req.method(), target)) {
-    if (!router_.authorized(req)) return send(router_.unauthorized(std::string(target)), false);
     if (length && *length > router_.config().uploadLimit)
       return send(tooLarge(*length, router_.config().uploadLimit), false);
     upload_.emplace(std::move(*header_));
@@ -99,7 +124,7 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
     upload_->get().body().open(uploadPath_.c_str(), beast::file_mode::write, fileError);
     if (fileError)
       return send(problem(http::status::internal_server_error, "storage-failed", "Storage failed",
-                          "cannot create the upload file: " + fileError.message(), "/v1/databases"),
+                          "cannot create the upload file: " + fileError.message(), instance),
                   false);
     stream_.expires_after(router_.config().uploadTimeout);
     http::async_read(stream_, buffer_, *upload_,

@@ -3,9 +3,11 @@
 /// One HTTP/1.1 connection, after Beast 1.74's advanced server: every handler runs on the
 /// connection's strand; each message gets a fresh parser (header first, then a body parser chosen
 /// by the route: a string body with the JSON size limit, or a file body for database uploads with
-/// their own limit); reads time out (expires_after). Responses are written one at a time, so the
-/// response queue of the Beast example has length one here: requests are read again only once the
-/// previous response is out. Uploads are validated on the blocking pool, never on an io thread.
+/// their own limit); a request without the token is answered 401 from its header, before any limit
+/// or syntax of its body is judged; reads time out (expires_after). Responses are written one at a
+/// time, so the response queue of the Beast example has length one here: requests are read again
+/// only once the previous response is out. Uploads are validated on the blocking pool, never on an
+/// io thread.
 
 #include <boost/asio/thread_pool.hpp>
 #include <boost/beast/core.hpp>
@@ -40,6 +42,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void lingeringClose();
   void onDrain(boost::beast::error_code ec, std::size_t n);
   void readError(boost::beast::error_code ec);
+  /// The problem `instance` of a request whose read failed: its path, as far as it was received.
+  std::string instanceOfFailedRead() const;
 
   boost::beast::tcp_stream stream_;
   boost::beast::flat_buffer buffer_;

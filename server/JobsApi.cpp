@@ -1,7 +1,14 @@
 #include "JobsApi.hpp"
 
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <filesystem>
 #include <regex>
+#include <utility>
 
 #include "CoverageExport.hpp"
 #include "DatabaseRef.hpp"
@@ -37,9 +44,75 @@ StringResponse notFinished(const JobRecord& job, const Target& target, const std
 
 StringResponse badParameter(const std::string& name, const std::string& message,
                             const Target& target) {
-  return problem(http::status::bad_request, "invalid-parameter", "Invalid query parameter",
-                 name + ": " + message, target.path,
-                 nlohmann::json::array({{{"pointer", name}, {"message", message}}}));
+  return invalidQueryParameter(name, message, target.path);
+}
+
+/// A query value quoted in a message, cut short: the message echoes the request, not a payload.
+std::string quotedValue(const std::string& value) {
+  constexpr std::size_t kMaxQuoted = 60;
+  return "\"" + (value.size() > kMaxQuoted ? value.substr(0, kMaxQuoted) + "..." : value) + "\"";
+}
+
+/// A descriptor closed when it goes out of scope.
+class Descriptor {
+ public:
+  explicit Descriptor(int fd) : fd_(fd) {}
+  ~Descriptor() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  Descriptor(const Descriptor&) = delete;
+  Descriptor& operator=(const Descriptor&) = delete;
+  int get() const { return fd_; }
+  int release() { return std::exchange(fd_, -1); }
+
+ private:
+  int fd_;
+};
+
+/// The job's folder opened without following a symlink at jobs/ or at the folder itself: a link
+/// planted below the data directory must not make the server serve files from elsewhere. -1 if it
+/// is absent or a link.
+int openJobFolder(const ServerConfig& config, const std::string& id) {
+  const Descriptor data(::open(config.dataDir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (data.get() < 0) return -1;
+  const Descriptor jobs(::openat(data.get(), "jobs", O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC));
+  if (jobs.get() < 0) return -1;
+  return ::openat(jobs.get(), id.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+}
+
+/// A regular file of the job's folder opened for reading; -1 if it is absent, a symlink or anything
+/// but a regular file. O_NONBLOCK: opening a FIFO planted there must not block the strand.
+int openJobFile(const ServerConfig& config, const std::string& id, const std::string& name) {
+  const Descriptor folder(openJobFolder(config, id));
+  if (folder.get() < 0) return -1;
+  Descriptor file(::openat(folder.get(), name.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC));
+  struct stat st {};
+  if (file.get() < 0 || ::fstat(file.get(), &st) != 0 || !S_ISREG(st.st_mode)) return -1;
+  return file.release();
+}
+
+/// A file response streaming an open descriptor (which it then owns).
+Response fileResponse(int fd, const std::string& contentType, const std::string& downloadName) {
+  FileResponse res{http::status::ok, 11};
+  boost::beast::file file;
+  file.native_handle(fd);
+  boost::beast::error_code ec;
+  res.body().reset(std::move(file), ec);
+  if (ec) throw std::runtime_error("cannot read " + downloadName + ": " + ec.message());
+  res.set(http::field::content_type, contentType);
+  res.set(http::field::content_disposition, "attachment; filename=\"" + downloadName + "\"");
+  res.prepare_payload();
+  return res;
+}
+
+/// Replaces, in every string of `node`, a path inside the data directory by the path relative to it.
+void relativeToDataDir(nlohmann::json& node, const std::string& dataDirPrefix) {
+  if (node.is_string()) {
+    const auto& text = node.get_ref<const std::string&>();
+    if (text.rfind(dataDirPrefix, 0) == 0) node = text.substr(dataDirPrefix.size());
+  } else if (node.is_structured()) {
+    for (auto& child : node) relativeToDataDir(child, dataDirPrefix);
+  }
 }
 
 std::string contentTypeFor(const std::string& name) {
@@ -68,11 +141,22 @@ bool isArtifactName(const std::string& name) {
 
 std::vector<std::string> JobsApi::artifacts(const std::string& id) const {
   std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(config_.jobDir(id), ec)) {
-    const std::string name = entry.path().filename().string();
-    if (entry.is_regular_file() && isArtifactName(name)) names.push_back(name);
+  const int folder = openJobFolder(config_, id);
+  if (folder < 0) return names;
+  DIR* dir = ::fdopendir(folder);
+  if (!dir) {
+    ::close(folder);
+    return names;
   }
+  // Listed as artifact() serves them: regular files, symlinks not followed.
+  while (const dirent* entry = ::readdir(dir)) {
+    const std::string name = entry->d_name;
+    struct stat st {};
+    if (isArtifactName(name) && ::fstatat(::dirfd(dir), entry->d_name, &st, AT_SYMLINK_NOFOLLOW) == 0 &&
+        S_ISREG(st.st_mode))
+      names.push_back(name);
+  }
+  ::closedir(dir);
   std::sort(names.begin(), names.end());
   return names;
 }
@@ -195,15 +279,15 @@ Response JobsApi::list(const Target& target) {
   filter.limit = kDefaultPageSize;
   if (auto it = target.query.find("state"); it != target.query.end()) {
     if (!state::isValid(it->second))
-      return badParameter("state", "\"" + it->second +
-                                       "\" is not one of QUEUED, RUNNING, SUCCEEDED, FAILED, "
+      return badParameter("state", quotedValue(it->second) +
+                                       " is not one of QUEUED, RUNNING, SUCCEEDED, FAILED, "
                                        "CANCELLING, CANCELLED",
                           target);
     filter.state = it->second;
   }
   if (auto it = target.query.find("kind"); it != target.query.end()) {
     if (it->second != "database" && it->second != "calibration" && it->second != "spray")
-      return badParameter("kind", "\"" + it->second + "\" is not one of database, calibration, spray",
+      return badParameter("kind", quotedValue(it->second) + " is not one of database, calibration, spray",
                           target);
     filter.kind = it->second;
   }
@@ -217,7 +301,7 @@ Response JobsApi::list(const Target& target) {
       n = 0;
     }
     if (n < 1 || n > kMaxPageSize)
-      return badParameter("page_size", "must be an integer from 1 to 1000", target);
+      return badParameter("page_size", quotedValue(it->second) + " is not an integer from 1 to 1000", target);
     filter.limit = n;
   }
   if (auto it = target.query.find("page_token"); it != target.query.end()) {
@@ -248,6 +332,8 @@ Response JobsApi::list(const Target& target) {
 
 Response JobsApi::get(const std::string& id, const Target& target) {
   const auto view = target.query.find("view");
+  if (view != target.query.end() && view->second != "full" && view->second != "basic")
+    return badParameter("view", quotedValue(view->second) + " is not one of basic, full", target);
   const bool full = view != target.query.end() && view->second == "full";
   if (!full)
     if (const auto body = views_.find(id)) return textResponse(http::status::ok, *body, "application/json");
@@ -311,7 +397,7 @@ Response JobsApi::coverage(const std::string& id, const Target& target) {
   std::string format = "json";
   if (auto it = target.query.find("format"); it != target.query.end()) format = it->second;
   if (format != "json" && format != "csv" && format != "h5")
-    return badParameter("format", "\"" + format + "\" is not one of json, csv, h5", target);
+    return badParameter("format", quotedValue(format) + " is not one of json, csv, h5", target);
   const auto stored = store_.coverage(id);
   if (stored.empty())
     return problem(http::status::not_found, "no-coverage", "No coverage distribution",
@@ -341,21 +427,26 @@ Response JobsApi::coverage(const std::string& id, const Target& target) {
     res.set(http::field::content_disposition, "attachment; filename=\"coverage.csv\"");
     return res;
   }
-  const auto path = config_.jobDir(id) / ("coverage_" + std::to_string(bins.size()) + ".h5.export");
+  const std::string exportName = "coverage_" + std::to_string(bins.size()) + ".h5.export";
+  // HDF5 would write through a symlink left at that name (or at the job's folder): the folder must be
+  // a real one, and a fresh file is made in it.
+  {
+    const Descriptor folder(openJobFolder(config_, id));
+    if (folder.get() < 0)
+      return problem(http::status::internal_server_error, "export-failed", "Export failed",
+                     "the folder of job " + id + " is missing or not a directory", target.path);
+    (void)::unlinkat(folder.get(), exportName.c_str(), 0);
+  }
+  const auto path = config_.jobDir(id) / exportName;
   std::string error;
   if (!writeCoverageH5(path, id, bins, error))
     return problem(http::status::internal_server_error, "export-failed", "Export failed", error,
                    target.path);
-  FileResponse res{http::status::ok, 11};
-  boost::beast::error_code ec;
-  res.body().open(path.c_str(), boost::beast::file_mode::scan, ec);
-  if (ec)
+  const int fd = openJobFile(config_, id, exportName);
+  if (fd < 0)
     return problem(http::status::internal_server_error, "export-failed", "Export failed",
-                   ec.message(), target.path);
-  res.set(http::field::content_type, "application/x-hdf5");
-  res.set(http::field::content_disposition, "attachment; filename=\"coverage.h5\"");
-  res.prepare_payload();
-  return res;
+                   "the written export cannot be opened as a regular file", target.path);
+  return fileResponse(fd, "application/x-hdf5", "coverage.h5");
 }
 
 Response JobsApi::artifact(const std::string& id, const std::string& name, const Target& target) {
@@ -366,17 +457,43 @@ Response JobsApi::artifact(const std::string& id, const std::string& name, const
                    target.path);
   const auto job = store_.job(id);
   if (!job) return notFound(id, target);
-  const auto path = config_.jobDir(id) / name;
-  FileResponse res{http::status::ok, 11};
-  boost::beast::error_code ec;
-  if (std::filesystem::is_regular_file(path)) res.body().open(path.c_str(), boost::beast::file_mode::scan, ec);
-  if (!std::filesystem::is_regular_file(path) || ec)
+  // A symlink is never followed, whether the name, the job's folder or jobs/ is one: only files the
+  // job wrote into its folder are served, as "not found" otherwise.
+  const int fd = openJobFile(config_, id, name);
+  if (fd < 0)
     return problem(http::status::not_found, "artifact-not-found", "Artifact not found",
                    "job " + id + " (" + job->state + ") has no artifact \"" + name + "\"",
                    target.path);
-  res.set(http::field::content_type, contentTypeFor(name));
-  res.set(http::field::content_disposition, "attachment; filename=\"" + name + "\"");
-  res.prepare_payload();
+  if (name == "job.json") return servedJobFile(fd, *job, target);
+  return fileResponse(fd, contentTypeFor(name), name);
+}
+
+Response JobsApi::servedJobFile(int fd, const JobRecord& job, const Target& target) const {
+  std::string text;
+  {
+    const Descriptor file(fd);
+    char chunk[65536];
+    ssize_t n;
+    while ((n = ::read(file.get(), chunk, sizeof chunk)) != 0) {
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) break;
+      text.append(chunk, static_cast<std::size_t>(n));
+    }
+    if (n < 0)
+      return problem(http::status::internal_server_error, "artifact-unreadable", "Artifact unreadable",
+                     "job.json of job " + job.id + " cannot be read", target.path);
+  }
+  auto document = nlohmann::json::parse(text, nullptr, false);
+  if (document.is_discarded())
+    return problem(http::status::internal_server_error, "artifact-unreadable", "Artifact unreadable",
+                   "job.json of job " + job.id + " is not JSON", target.path);
+  // The worker gives the solver the database as a path on this machine; the client sees the id it
+  // gave, and any other path inside the data directory relative to it.
+  if (!job.databaseRef.empty() && document.is_object()) document["database"] = job.databaseRef;
+  relativeToDataDir(document, (config_.dataDir / "").string());
+  const std::string served = document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  auto res = textResponse(http::status::ok, served, contentTypeFor("job.json"));
+  res.set(http::field::content_disposition, "attachment; filename=\"job.json\"");
   return res;
 }
 

@@ -38,6 +38,8 @@ class JobsApi {
  private:
   /// Artifact names the job directory holds now (fixed names and *.svg).
   std::vector<std::string> artifacts(const std::string& id) const;
+  /// The job's job.json (open descriptor, taken over) as served: no path of this machine in it.
+  Response servedJobFile(int fd, const JobRecord& job, const Target& target) const;
 
   JobStore& store_;
   WorkerPool& pool_;

@@ -1,5 +1,8 @@
 #include "Problem.hpp"
 
+#include "Target.hpp"
+#include "scene/SchemaExplainer.hpp"
+
 namespace rcfd::server {
 
 StringResponse problem(http::status status, const std::string& type, const std::string& title,
@@ -9,23 +12,40 @@ StringResponse problem(http::status status, const std::string& type, const std::
                          {"title", title},
                          {"status", static_cast<int>(status)},
                          {"detail", detail},
-                         {"instance", instance}};
+                         {"instance", instancePath(instance)}};
   if (!errors.is_null()) body["errors"] = errors;
   return textResponse(status, jsonText(body), "application/problem+json");
 }
 
-StringResponse invalidInput(const InputError& error, const std::string& instance) {
+namespace {
+/// The errors[] member: one {pointer, message} per violation.
+nlohmann::json errorList(const std::vector<Violation>& violations) {
   nlohmann::json errors = nlohmann::json::array();
-  for (const auto& v : error.violations())
-    errors.push_back({{"pointer", v.pointer}, {"message", v.message}});
+  for (const auto& v : violations) errors.push_back({{"pointer", v.pointer}, {"message", v.message}});
+  return errors;
+}
+}  // namespace
+
+StringResponse invalidInput(const InputError& error, const std::string& instance) {
   const auto count = error.violations().size();
   return problem(http::status::unprocessable_entity, "invalid-input", "Invalid input",
                  std::to_string(count) + (count == 1 ? " violation" : " violations") + " in " +
                      error.source() + "; see errors[] for each JSON pointer",
-                 instance, errors);
+                 instance, errorList(error.violations()));
 }
 
-std::string jsonText(const nlohmann::json& body) { return body.dump() + "\n"; }
+StringResponse invalidQueryParameter(const std::string& name, const std::string& message,
+                                     const std::string& instance) {
+  return problem(http::status::bad_request, "invalid-parameter", "Invalid query parameter",
+                 "query parameter " + name + ": " + message, instance,
+                 errorList({{appendPointer("/query", name), message}}));
+}
+
+// Invalid UTF-8 (a percent-decoded query value quoted in a message) becomes U+FFFD instead of an
+// exception: the answer is still the 4xx it describes.
+std::string jsonText(const nlohmann::json& body) {
+  return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
 
 StringResponse jsonResponse(http::status status, const nlohmann::json& body) {
   return textResponse(status, jsonText(body), "application/json");

@@ -12,13 +12,19 @@
 namespace rcfd::server {
 
 /// A problem response. `type` is a short slug ("invalid-json") turned into a URN; `instance` is the
-/// request target the problem is about.
+/// path of the request the problem is about, sent as instancePath() makes it: never empty, ASCII.
 StringResponse problem(http::status status, const std::string& type, const std::string& title,
                        const std::string& detail, const std::string& instance,
                        const nlohmann::json& errors = nullptr);
 
 /// 422 listing every violation of an InputError with its JSON pointer.
 StringResponse invalidInput(const InputError& error, const std::string& instance);
+
+/// 400 for a query parameter the endpoint does not take as given, in the shape of invalidInput:
+/// errors[] holds one entry whose pointer is "/query/NAME" (RFC 6901) and whose message says what is
+/// allowed.
+StringResponse invalidQueryParameter(const std::string& name, const std::string& message,
+                                     const std::string& instance);
 
 /// A JSON body with the given status (application/json).
 StringResponse jsonResponse(http::status status, const nlohmann::json& body);

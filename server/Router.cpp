@@ -61,22 +61,23 @@ bool Router::authorized(const http::fields& headers) const {
   return sameSecret(value.substr(scheme.size()), config_.token);
 }
 
-StringResponse Router::unauthorized(const std::string& target) const {
+StringResponse Router::unauthorized(const std::string& instance) const {
   auto res = problem(http::status::unauthorized, "unauthorized", "Unauthorized",
                      "send \"Authorization: Bearer <token>\" with the server's token "
                      "(rcfd --token or RCFD_TOKEN)",
-                     target);
+                     instance);
   res.set(http::field::www_authenticate, "Bearer realm=\"rcfd\"");
   return res;
 }
 
 Response Router::handle(const Request& req) {
   const std::string raw(req.target());
+  // The token comes first: a client without one learns nothing about its request but that.
+  if (!isPublic(req.method(), raw) && !authorized(req)) return unauthorized(instancePath(raw));
   const auto target = parseTarget(raw);
   if (!target)
     return problem(http::status::bad_request, "invalid-target", "Malformed request target",
-                   "the request target is not a valid path and query", raw.substr(0, 200));
-  if (!isPublic(req.method(), raw) && !authorized(req)) return unauthorized(target->path);
+                   "the request target is not a valid path and query", instancePath(raw));
   if (target->dotSegment)
     return problem(http::status::bad_request, "invalid-target", "Path segments . and .. refused",
                    "resource names are never paths", target->path);

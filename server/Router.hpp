@@ -23,7 +23,8 @@ class Router {
   /// Whether the request body is a database upload (streamed to a file, not held in memory).
   static bool isUpload(http::verb method, std::string_view target);
 
-  StringResponse unauthorized(const std::string& target) const;
+  /// 401 with the Bearer challenge; `instance` is the request path.
+  StringResponse unauthorized(const std::string& instance) const;
   DatabasesApi& databases() { return databases_; }
   Metrics& metrics() { return metrics_; }
   const ServerConfig& config() const { return config_; }

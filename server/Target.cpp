@@ -59,4 +59,21 @@ std::optional<Target> parseTarget(std::string_view target) {
   return t;
 }
 
+std::string instancePath(std::string_view target) {
+  constexpr std::size_t kMaxLength = 200;
+  const std::string_view path = target.substr(0, target.find('?'));
+  std::string out;
+  for (const char c : path) {
+    if (out.size() >= kMaxLength) break;
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte > 0x20 && byte < 0x7f) {
+      out.push_back(c);
+    } else {
+      static const char* const hex = "0123456789ABCDEF";
+      out += {'%', hex[byte >> 4], hex[byte & 15]};
+    }
+  }
+  return out.empty() ? "*" : out;
+}
+
 }  // namespace rcfd::server

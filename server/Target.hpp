@@ -20,4 +20,9 @@ struct Target {
 /// Parses an origin-form target ("/v1/jobs?state=QUEUED"); nullopt if it is malformed.
 std::optional<Target> parseTarget(std::string_view target);
 
+/// The `instance` of a problem about a request with this target: its path without the query, bytes
+/// outside printable ASCII percent-encoded, at most 200 characters; "*" (the asterisk form of
+/// RFC 9112: the server as a whole) when the request line held no target.
+std::string instancePath(std::string_view target);
+
 }  // namespace rcfd::server

@@ -196,7 +196,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
   int logFd = -1, pipeFds[2] = {-1, -1};
   pid_t pid = -1;
   if (setupError.empty()) {
-    logFd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    logFd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0600);
     if (logFd < 0 || ::pipe2(pipeFds, O_CLOEXEC) != 0)
       setupError = std::string("cannot open the solver log or pipe: ") + std::strerror(errno);
   }

@@ -12,6 +12,7 @@
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/thread_pool.hpp>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -80,6 +81,24 @@ net::ip::tcp::endpoint parseListen(const std::string& text) {
   return {net::ip::make_address(host), static_cast<unsigned short>(port)};
 }
 
+/// Warns when the data directory lets group or others in: the server makes what it creates there
+/// owner-only, but through an open directory older files (a store or job folders made under another
+/// umask) stay readable.
+void warnIfOpenToOthers(const std::filesystem::path& dataDir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto status = fs::status(dataDir, ec);
+  if (ec || !fs::is_directory(status)) return;
+  const auto open = status.permissions() & (fs::perms::group_all | fs::perms::others_all);
+  if (open == fs::perms::none) return;
+  char mode[8];
+  std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(status.permissions() & fs::perms::mask));
+  std::cerr << "rcfd-server: warning: data directory " << dataDir.string() << " is accessible to "
+            << ((open & fs::perms::others_all) != fs::perms::none ? "others" : "its group") << " (mode "
+            << mode << "): jobs, results and the job store can be read through it; chmod 700 "
+            << dataDir.string() << "\n";
+}
+
 std::filesystem::path defaultSolver() {
   std::error_code ec;
   const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
@@ -126,7 +145,11 @@ int main(int argc, char** argv) {
 
   try {
     std::signal(SIGPIPE, SIG_IGN);
+    // Jobs, results and the store belong to the users who submitted them: whatever the server and its
+    // solvers create is owner-only (directories 0700, files 0600), whatever umask it was started with.
+    ::umask(077);
     config.dataDir = std::filesystem::absolute(dataDir);
+    warnIfOpenToOthers(config.dataDir);
     std::filesystem::create_directories(config.dataDir / "jobs");
     std::filesystem::create_directories(config.databaseDir());
     config.token = resolveToken(tokenFile, config.dataDir);
