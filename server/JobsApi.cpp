@@ -184,6 +184,7 @@ nlohmann::json JobsApi::toJson(const JobRecord& job, bool withRequest) const {
       {"links",
        {{"self", self},
         {"cancel", self + ":cancel"},
+        {"retry", self + ":retry"},
         {"events", self + "/events"},
         {"result", self + "/result"},
         {"coverage", self + "/coverage"}}},
@@ -377,6 +378,22 @@ Response JobsApi::cancel(const std::string& id, const Target& target) {
   }
   return problem(http::status::conflict, "job-busy", "Job changed state repeatedly",
                  "try the cancel again", target.path);
+}
+
+Response JobsApi::retry(const std::string& id, const Target& target) {
+  const auto job = store_.job(id);
+  if (!job) return notFound(id, target);
+  if (job->state != state::failed && job->state != state::cancelled)
+    return problem(http::status::conflict, "job-not-retryable", "Job cannot be retried",
+                   "job " + id + " is " + job->state + "; only a FAILED or CANCELLED job is retried", target.path);
+  std::error_code ec;
+  const bool checkpoint = std::filesystem::exists(config_.jobDir(id) / "checkpoint.h5", ec);
+  if (!store_.transition(id, job->state, state::queued,
+                         checkpoint ? "retry requested; resumes from its checkpoint"
+                                    : "retry requested; no checkpoint, starts from the beginning"))
+    return problem(http::status::conflict, "job-busy", "Job changed state", "try the retry again", target.path);
+  pool_.wake();
+  return jsonResponse(http::status::ok, toJson(*store_.job(id)));
 }
 
 Response JobsApi::result(const std::string& id, const Target& target) {

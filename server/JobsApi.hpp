@@ -27,6 +27,8 @@ class JobsApi {
   Response list(const Target& target);
   Response get(const std::string& id, const Target& target);
   Response cancel(const std::string& id, const Target& target);
+  /// A FAILED or CANCELLED job queued again; its solver resumes from the job's checkpoint if it has one.
+  Response retry(const std::string& id, const Target& target);
   Response result(const std::string& id, const Target& target);
   Response events(const std::string& id, const Target& target);
   Response coverage(const std::string& id, const Target& target);

@@ -139,6 +139,11 @@ Response Router::route(const Request& req, const Target& target) {
       if (!post) return methodNotAllowed(target, "POST");
       return jobs_.cancel(id.substr(0, id.size() - 7), target);
     }
+    // POST /v1/jobs/{id}:retry
+    if (s.size() == 3 && id.size() > 6 && id.compare(id.size() - 6, 6, ":retry") == 0) {
+      if (!post) return methodNotAllowed(target, "POST");
+      return jobs_.retry(id.substr(0, id.size() - 6), target);
+    }
     if (s.size() == 3) {
       if (!get) return methodNotAllowed(target, "GET");
       return jobs_.get(id, target);

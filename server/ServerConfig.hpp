@@ -24,6 +24,7 @@ struct ServerConfig {
   std::chrono::seconds uploadTimeout{3600};          ///< whole-upload timeout
   std::chrono::seconds shutdownGrace{120};           ///< wait for solvers to checkpoint on stop
   std::chrono::seconds cancelGrace{30};              ///< a cancelled solver still running after this is killed
+  int autoRetries = 1;  ///< times a job whose solver was killed from outside (SIGKILL: out of memory) is requeued
 
   std::filesystem::path jobDir(const std::string& id) const { return dataDir / "jobs" / id; }
   std::filesystem::path databaseDir() const { return dataDir / "databases"; }

@@ -391,6 +391,18 @@ void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::stri
                             " s of the cancel and was killed (SIGKILL); its checkpoint, if any, is kept");
       return;
     }
+    // Killed from outside (the kernel's out-of-memory killer sends SIGKILL): the checkpoint is intact,
+    // so the job resumes from it, a limited number of times since a job that needs too much memory
+    // will be killed again.
+    const int attempts = current ? current->attempt : job.attempt;  // `job` was read before it started
+    if (sig == SIGKILL && !cancelling && !stopping && attempts <= config_.autoRetries &&
+        store_.transition(job.id, from, state::queued,
+                          "the solver was killed by SIGKILL (out of memory?); queued again to resume from its "
+                          "checkpoint (automatic retry " + std::to_string(attempts) + " of " +
+                              std::to_string(config_.autoRetries) + ")")) {
+      wake();
+      return;
+    }
     store_.transition(job.id, from, cancelling ? state::cancelled : state::failed, {},
                       withTail("the solver was killed by " + signalName(sig)));
     return;

@@ -132,6 +132,10 @@ int main(int argc, char** argv) {
   int cancelGrace = static_cast<int>(config.cancelGrace.count());
   app.add_option("--cancel-grace", cancelGrace, "seconds a cancelled solver gets to checkpoint before it is killed")
       ->capture_default_str()->check(CLI::Range(1, 86400));
+  app.add_option("--auto-retries", config.autoRetries,
+                 "times a job whose solver is killed from outside the server (SIGKILL, as the kernel's out-of-memory "
+                 "killer does) is queued again to resume from its checkpoint")
+      ->capture_default_str()->check(CLI::Range(0, 100));
   int idleBeforeToken = static_cast<int>(config.idleBeforeToken.count());
   app.add_option("--idle-before-token", idleBeforeToken,
                  "seconds a connection may wait for its first request with a token before it is closed")

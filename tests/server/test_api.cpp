@@ -120,6 +120,24 @@ TEST_F(Api, ACalibrationJobThatWouldStopAtItsStartIsRefusedAtSubmit) {
   EXPECT_TRUE(server_->get("/v1/jobs").json().at("jobs").empty());
 }
 
+TEST_F(Api, OnlyAFailedOrCancelledJobIsRetriedAndItIsQueuedAgain) {
+  const auto submitted = server_->post("/v1/jobs", databaseJob(7).dump());
+  ASSERT_EQ(submitted.status, 202) << submitted.body;
+  const std::string id = submitted.json().at("id");
+  EXPECT_EQ(submitted.json().at("links").at("retry"), "/v1/jobs/" + id + ":retry");
+  expectProblem(server_->post("/v1/jobs/" + id + ":retry", ""), 409);  // QUEUED
+  ASSERT_EQ(server_->post("/v1/jobs/" + id + ":cancel", "").status, 200);
+  const auto retried = server_->post("/v1/jobs/" + id + ":retry", "");
+  ASSERT_EQ(retried.status, 200) << retried.body;
+  EXPECT_EQ(retried.json().at("state"), "QUEUED");
+  EXPECT_TRUE(retried.json().at("finished_at").is_null()) << retried.body;
+  const auto events = server_->get("/v1/jobs/" + id + "/events").json().at("events");
+  EXPECT_EQ(events.back().at("from"), "CANCELLED");
+  EXPECT_NE(events.back().at("reason").get<std::string>().find("no checkpoint"), std::string::npos) << events.dump();
+  expectProblem(server_->post("/v1/jobs/00000000000000000000000000000000:retry", ""), 404);
+  expectProblem(server_->get("/v1/jobs/" + id + ":retry"), 405);
+}
+
 TEST_F(Api, SchemaViolationIs422WithPointer) {
   auto job = databaseJob();
   job["kind"] = "teleport";

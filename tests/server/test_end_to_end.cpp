@@ -151,12 +151,13 @@ class EndToEnd : public ::testing::Test {
   }
   // Solvers at the server's niceness by default here: ctest -j runs other tests of the same session
   // beside these, and a niced solver would wait behind them (the suite's time, not what is tested).
-  std::unique_ptr<ServerProcess> start(int workers, int workerNice = 0) {
+  std::unique_ptr<ServerProcess> start(int workers, int workerNice = 0, int autoRetries = 1) {
     return std::make_unique<ServerProcess>(
         tmp_->path() / "data", "e2e-token",
         std::vector<std::string>{"--workers", std::to_string(workers), "--solver",
                                  (binaryDir() / "rcfd-solve").string(), "--shutdown-grace", "20",
-                                 "--worker-nice", std::to_string(workerNice)});
+                                 "--worker-nice", std::to_string(workerNice), "--auto-retries",
+                                 std::to_string(autoRetries)});
   }
   std::string upload(const ServerProcess& server) {
     const auto r = client(server, {"upload", (tmp_->path() / "db.h5").string()});
@@ -235,7 +236,7 @@ int niceOf(pid_t pid) {
 }
 
 TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
-  auto server = start(2, 5);  // and the solvers run 5 nicer than the server
+  auto server = start(2, 5, 0);  // the solvers run 5 nicer than the server; no automatic retry
   const std::string db = upload(*server);
   const std::string victim = submit(*server, sprayJob(db, 1000.0, 1));  // far too long to finish
   const std::string other = submit(*server, sprayJob(db, 0.2, 2));
@@ -259,6 +260,58 @@ TEST_F(EndToEnd, KillingOneSolverFailsOnlyItsJob) {
   const auto fine = pollJob(*server, other, isFinal);
   EXPECT_EQ(fine.at("state"), "SUCCEEDED") << fine.dump(2);
   EXPECT_EQ(server->get("/v1/health").status, 200);
+}
+
+/// The solver (the server's only child) once the job has written a checkpoint; -1 if none within 30 s.
+static pid_t solverWithCheckpoint(const ServerProcess& server, const std::filesystem::path& checkpoint) {
+  for (int i = 0; i < 6000; ++i) {
+    const auto solvers = childrenOf(server.pid());
+    if (solvers.size() == 1 && std::filesystem::exists(checkpoint)) return solvers[0];
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return -1;
+}
+
+// A solver killed from outside (SIGKILL, as the out-of-memory killer does) is queued again once and
+// resumes from its checkpoint; killed again, the job fails, and a retry through the API resumes it once
+// more to the end (that a resume gives the uninterrupted result is ServerKilledMidJobResumesToTheSameResult).
+TEST_F(EndToEnd, AKilledSolverIsRetriedFromItsCheckpointAutomaticallyAndOnRequest) {
+  auto server = start(1, 0, 1);
+  const std::string db = upload(*server);
+  const std::string id = submit(*server, sprayJob(db, 4.0, 6));
+  const auto checkpoint = tmp_->path() / "data" / "jobs" / id / "checkpoint.h5";
+  pid_t solver = solverWithCheckpoint(*server, checkpoint);
+  ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen";
+  ASSERT_EQ(::kill(solver, SIGKILL), 0);
+  // The retry starts a new solver (attempt 2); kill that one too once it runs.
+  const auto second = pollJob(*server, id, [](const nlohmann::json& j) {
+    return j.at("state") == "RUNNING" && j.at("attempt").get<int>() == 2;
+  });
+  ASSERT_EQ(second.at("attempt"), 2) << second.dump(2);
+  pid_t again = -1;
+  for (int i = 0; i < 6000 && again < 0; ++i) {
+    const auto solvers = childrenOf(server->pid());
+    if (solvers.size() == 1 && solvers[0] != solver) again = solvers[0];
+    else std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (again > 0) ::kill(again, SIGKILL);
+  const auto failed = pollJob(*server, id, isFinal);
+  if (failed.at("state") == "SUCCEEDED") GTEST_SKIP() << "the second attempt finished before it was killed";
+  ASSERT_EQ(failed.at("state"), "FAILED") << failed.dump(2);
+  EXPECT_NE(failed.at("error").get<std::string>().find("SIGKILL"), std::string::npos) << failed.dump(2);
+  ASSERT_EQ(server->post("/v1/jobs/" + id + ":retry", "").status, 200);
+  const auto done = pollJob(*server, id, isFinal, std::chrono::seconds(90));
+  ASSERT_EQ(done.at("state"), "SUCCEEDED") << done.dump(2);
+  EXPECT_EQ(done.at("attempt"), 3);
+  const auto events = server->get("/v1/jobs/" + id + "/events").json().at("events");
+  int automatic = 0, requested = 0;
+  for (const auto& e : events) {
+    const std::string reason = e.at("reason");
+    automatic += reason.find("automatic retry") != std::string::npos;
+    requested += reason.find("retry requested; resumes from its checkpoint") != std::string::npos;
+  }
+  EXPECT_EQ(automatic, 1) << events.dump(2);
+  EXPECT_EQ(requested, 1) << events.dump(2);
 }
 
 // The job must still be running when the server dies, however fast the machine: once the solver has
