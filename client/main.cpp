@@ -227,6 +227,8 @@ int main(int argc, char** argv) {
   }
   auto* cancel = app.add_subcommand("cancel", "cancel a job");
   cancel->add_option("ID", id)->required();
+  auto* retry = app.add_subcommand("retry", "queue a failed or cancelled job again (resumes from its checkpoint)");
+  retry->add_option("ID", id)->required();
   auto* result = app.add_subcommand("result", "print a succeeded job's summary.json");
   result->add_option("ID", id)->required();
   auto* coverage = app.add_subcommand("coverage", "download a spray job's coverage distribution");
@@ -294,9 +296,10 @@ int main(int argc, char** argv) {
       return kOk;
     }
     if (waitCmd->parsed()) return waitFor(client, urlEncode(id), interval, reconnect);
-    if (cancel->parsed()) {
-      auto res = client.post("/v1/jobs/" + urlEncode(id) + ":cancel", "");
-      if (!res.ok()) fail(res, "cancel job " + id);
+    if (cancel->parsed() || retry->parsed()) {
+      const std::string action = cancel->parsed() ? "cancel" : "retry";
+      auto res = client.post("/v1/jobs/" + urlEncode(id) + ":" + action, "");
+      if (!res.ok()) fail(res, action + " job " + id);
       const auto job = parseJson(res);
       std::cout << job.value("id", "") << " " << job.value("state", "") << "\n";
       return kOk;

@@ -109,6 +109,11 @@ TEST_F(Client, SubmitStatusJobsCancel) {
   EXPECT_EQ(cancel.code, 0) << cancel.err;
   EXPECT_NE(cancel.out.find("CANCELLED"), std::string::npos);
   EXPECT_EQ(server_->get("/v1/jobs/" + id).json().at("state"), "CANCELLED");
+  const auto retried = runClient({"retry", id}, env());  // CANCELLED -> QUEUED
+  EXPECT_EQ(retried.code, 0) << retried.err;
+  EXPECT_NE(retried.out.find("QUEUED"), std::string::npos) << retried.out;
+  ASSERT_EQ(runClient({"cancel", id}, env()).code, 0);
+  EXPECT_EQ(runClient({"retry", "00000000000000000000000000000000"}, env()).code, 1);
   // A finished job's status shows when it finished.
   const auto finished = runClient({"status", id}, env());
   EXPECT_EQ(finished.code, 0) << finished.err;
