@@ -10,6 +10,7 @@ packages=(
   nlohmann-json3-dev     # JSON
   libvalijson-dev        # JSON Schema (draft 7) validation
   libsqlite3-dev sqlite3 # job store
+  libssl-dev             # OpenSSL: HMAC-SHA256 of the server's page tokens
   jq                     # composes job files in scripts/pipeline.sh (the README main command)
   libcli11-dev           # command lines
   libspdlog-dev          # logging

@@ -13,6 +13,7 @@
 #include "CoverageExport.hpp"
 #include "DatabaseRef.hpp"
 #include "Ids.hpp"
+#include "PageToken.hpp"
 #include "Problem.hpp"
 #include "WorkerPool.hpp"
 #include "scene/SceneJson.hpp"
@@ -307,8 +308,9 @@ Response JobsApi::list(const Target& target) {
   }
   if (auto it = target.query.find("page_token"); it != target.query.end()) {
     // The token carries the filters it was issued for, so a page never mixes two listings.
-    const auto decoded = base64UrlDecode(it->second);
-    auto token = decoded ? nlohmann::json::parse(*decoded, nullptr, false) : nlohmann::json();
+    // Signed (PageToken.hpp): a token the server did not issue is refused, however well formed.
+    const auto verified = verifyPageToken(it->second, config_.pageTokenKey);
+    const nlohmann::json token = verified ? *verified : nlohmann::json();
     if (!token.is_object() || !token.contains("after") || !token["after"].is_number_integer() ||
         token.value("state", "") != filter.state || token.value("kind", "") != filter.kind)
       return badParameter("page_token",
@@ -326,7 +328,7 @@ Response JobsApi::list(const Target& target) {
   if (more) {
     const nlohmann::json token = {
         {"after", rows.back().seq}, {"state", filter.state}, {"kind", filter.kind}};
-    body["next_page_token"] = base64UrlEncode(token.dump());
+    body["next_page_token"] = signPageToken(token, config_.pageTokenKey);
   }
   return jsonResponse(http::status::ok, body);
 }

@@ -12,6 +12,7 @@ namespace rcfd::server {
 struct ServerConfig {
   std::filesystem::path dataDir;      ///< rcfd.sqlite, jobs/<id>/, databases/
   std::string token;                  ///< bearer token required on everything but /v1/health
+  std::string pageTokenKey;           ///< signs page tokens (PageToken.hpp)
   int workers = 1;                    ///< concurrent solver processes (0: jobs stay QUEUED)
   int workerNice = 10;                ///< solvers run this much nicer than the server [0, 19]
   std::filesystem::path solverPath;   ///< the rcfd-solve executable

@@ -22,6 +22,7 @@
 #include "JobStore.hpp"
 #include "Listener.hpp"
 #include "Metrics.hpp"
+#include "PageToken.hpp"
 #include "Router.hpp"
 #include "ServerConfig.hpp"
 #include "WorkerPool.hpp"
@@ -157,6 +158,7 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(config.dataDir / "jobs");
     std::filesystem::create_directories(config.databaseDir());
     config.token = resolveToken(tokenFile, config.dataDir);
+    config.pageTokenKey = pageTokenKey(config.dataDir);
     config.solverPath = solver.empty() ? defaultSolver() : std::filesystem::absolute(solver);
     config.jsonBodyLimit = maxBody;
     config.uploadLimit = maxUpload;

@@ -352,6 +352,18 @@ TEST_F(Api, PaginatesTwentyFiveJobsInPagesOfTen) {
   // A token used with other filters, or a forged one, is refused.
   expectProblem(server_->get("/v1/jobs?page_size=10&state=RUNNING&page_token=" + token), 400);
   expectProblem(server_->get("/v1/jobs?page_token=garbage!"), 400);
+  // Well-formed but not issued by this server: {"after":1,"kind":"","state":""} unsigned, with a made-up
+  // signature, and with the signature of a real token.
+  const std::string payload = "eyJhZnRlciI6MSwia2luZCI6IiIsInN0YXRlIjoiIn0";
+  const std::string signature = token.substr(token.find('.') + 1);
+  for (const std::string& forged : {payload, payload + ".AAAA", payload + "." + signature})
+    expectProblem(server_->get("/v1/jobs?page_size=10&page_token=" + forged), 400);
+  // The signing key is kept in the data directory: a token outlives a restart of the server.
+  const auto second = server_->get("/v1/jobs?page_size=10").json().at("next_page_token").get<std::string>();
+  server_ = std::make_unique<ServerProcess>(data_->path() / "data", "test-token-123");
+  const auto after = server_->get("/v1/jobs?page_size=10&page_token=" + second);
+  ASSERT_EQ(after.status, 200) << after.body;
+  EXPECT_EQ(after.json().at("jobs").at(0).at("id"), submitted[10]);
   expectProblem(server_->get("/v1/jobs?page_size=0"), 400);
   expectProblem(server_->get("/v1/jobs?state=DONE"), 400);
 }
