@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "analysis/CalibrationReport.hpp"
+#include "core/Errors.hpp"
 #include "core/Svg.hpp"
 #include "geometry/Apparatus.hpp"
 
@@ -47,7 +48,8 @@ void drawOutline(SvgDocument& svg, const Apparatus& app, double shift) {
   }
 }
 
-std::string alphaFigure(const Scene& scene, const FieldDatabase& db, const std::string& dir) {
+std::string alphaFigure(const Scene& scene, const FieldDatabase& db, const std::string& dir,
+                        const std::function<bool()>& stopRequested) {
   const CartesianGrid& g = db.grid();
   const Apparatus app(scene.apparatus);
   const int k = midplaneLayer(scene, g);
@@ -71,7 +73,7 @@ std::string alphaFigure(const Scene& scene, const FieldDatabase& db, const std::
     panel(std::vector<double>(f->alpha_p.begin(), f->alpha_p.end()), p,
           "t = " + fmt("%.3f", frames[p] * db.dtRec()) + " s");
   }
-  panel(meanAlphaP(db), frames.size(), "time average");
+  panel(meanAlphaP(db, stopRequested), frames.size(), "time average");
   // Colour bar 0 .. kAlphaScale.
   const double bx = double(panels) * (w + gap);
   constexpr int kBarSteps = 50;
@@ -137,9 +139,12 @@ std::string pressureFigure(const PressureDropSeries& p, const std::string& dir) 
 
 }  // namespace
 
-std::vector<double> meanAlphaP(const FieldDatabase& db) {
+std::vector<double> meanAlphaP(const FieldDatabase& db, const std::function<bool()>& stopRequested) {
   std::vector<double> sum(std::size_t(db.grid().cellCount()), 0.0);
   for (int n = 0; n < db.frameCount(); ++n) {
+    if (stopRequested && stopRequested())
+      throw Cancelled("stopped while averaging alpha_P over the frames (frame " + std::to_string(n) + " of " +
+                      std::to_string(db.frameCount()) + ")");
     const auto f = db.frame(n);
     for (std::size_t c = 0; c < sum.size(); ++c) sum[c] += f->alpha_p[c];
   }
@@ -158,8 +163,9 @@ std::vector<int> snapshotFrames(int frameCount, int count) {
 }
 
 std::vector<std::string> writeDatabaseFigures(const Scene& scene, const FieldDatabase& db,
-                                              const PressureDropSeries& pressureDrop, const std::string& outDir) {
-  std::vector<std::string> names{alphaFigure(scene, db, outDir)};
+                                              const PressureDropSeries& pressureDrop, const std::string& outDir,
+                                              const std::function<bool()>& stopRequested) {
+  std::vector<std::string> names{alphaFigure(scene, db, outDir, stopRequested)};
   if (!pressureDrop.pa.empty() && pressureDrop.dt > 0.0) names.push_back(pressureFigure(pressureDrop, outDir));
   return names;
 }

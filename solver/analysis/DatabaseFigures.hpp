@@ -4,6 +4,7 @@
 /// and averaged over all frames, each with the apparatus outline (walls, inlet, outlet, draft plates),
 /// and the bed pressure-drop series with its mean and dominant frequency.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,8 +14,9 @@
 
 namespace rcfd::analysis {
 
-/// alpha_P averaged over every frame of the database, per cell (x fastest) [-].
-std::vector<double> meanAlphaP(const FieldDatabase& db);
+/// alpha_P averaged over every frame of the database, per cell (x fastest) [-]. `stopRequested` is
+/// polled before each frame (a long database takes minutes to read); true throws rcfd::Cancelled.
+std::vector<double> meanAlphaP(const FieldDatabase& db, const std::function<bool()>& stopRequested = {});
 
 /// Frames shown as snapshots: `count` instants evenly spread over the database, first and last
 /// included (fewer when the database has fewer frames).
@@ -28,8 +30,10 @@ struct PressureDropSeries {
 };
 
 /// Writes database_alpha_p.svg (snapshots and the time average) and, when the series is not empty,
-/// database_pressure_drop.svg into outDir; returns the file names written.
+/// database_pressure_drop.svg into outDir; returns the file names written. `stopRequested` as in
+/// meanAlphaP.
 std::vector<std::string> writeDatabaseFigures(const Scene& scene, const FieldDatabase& db,
-                                              const PressureDropSeries& pressureDrop, const std::string& outDir);
+                                              const PressureDropSeries& pressureDrop, const std::string& outDir,
+                                              const std::function<bool()>& stopRequested = {});
 
 }  // namespace rcfd::analysis

@@ -54,10 +54,12 @@ CfdDemSimulation::CfdDemSimulation(const Scene& scene, std::uint64_t seed, const
 
 CfdDemSimulation::~CfdDemSimulation() = default;
 
-FillResult CfdDemSimulation::fillAndSettle(const std::function<bool()>& stopRequested) {
+FillResult CfdDemSimulation::fillAndSettle(const std::function<bool()>& stopRequested,
+                                           const std::function<void(FillStage)>& stageStarted) {
   FillOptions options;
   options.seed = seed_;
   options.stop_requested = stopRequested;
+  options.stage_started = stageStarted;
   options.max_settle_time = scene_.dem.settle_time;
   const FillResult r = rcfd::fillAndSettle(*dem_, defaultFillRegion(scene_.apparatus), parcelsForBedMass(scene_), options);
   demStep_ = dem_->steps();

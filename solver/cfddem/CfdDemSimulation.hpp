@@ -57,8 +57,10 @@ class CfdDemSimulation {
   ~CfdDemSimulation();
 
   /// Inserts the scene's bed mass as parcels and lets it settle (DEM only, gas off), at most
-  /// scene.dem.settle_time. Deterministic for the seed.
-  FillResult fillAndSettle(const std::function<bool()>& stopRequested = {});
+  /// scene.dem.settle_time. Deterministic for the seed. `stopRequested` and `stageStarted` as
+  /// FillOptions::stop_requested and FillOptions::stage_started.
+  FillResult fillAndSettle(const std::function<bool()>& stopRequested = {},
+                           const std::function<void(FillStage)>& stageStarted = {});
 
   /// Scales the inlet and nozzle flows by factor in [0, 1] (the database job ramps the gas up).
   void setFlowFactor(double factor);

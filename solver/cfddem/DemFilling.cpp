@@ -33,13 +33,21 @@ FillRegion defaultFillRegion(const ApparatusSpec& a) {
 }
 
 namespace {
-/// DEM steps of about one millisecond: how often filling and settling look at the stop request.
+/// DEM steps of about one millisecond: how often settling looks at the kinetic energy.
 long stepsPerMillisecond(const DemSystem& dem) { return std::max(1L, static_cast<long>(1e-3 / dem.timeStep())); }
 
 void throwIfStopRequested(const DemSystem& dem, const std::function<bool()>& stop_requested) {
   if (stop_requested && stop_requested())
     throw Cancelled("stopped while filling and settling the bed at t = " + std::to_string(dem.time()) +
                     " s; nothing is kept: the next run fills again");
+}
+
+/// `steps` DEM steps with a look at the stop request before each.
+void runStoppable(DemSystem& dem, long steps, const std::function<bool()>& stop_requested) {
+  for (long s = 0; s < steps; ++s) {
+    throwIfStopRequested(dem, stop_requested);
+    dem.step();
+  }
 }
 }  // namespace
 
@@ -51,8 +59,7 @@ double settle(DemSystem& dem, double max_time, double fraction, bool* settled,
   const long check = stepsPerMillisecond(dem);
   bool ok = false;
   while (dem.time() - t0 < max_time) {
-    throwIfStopRequested(dem, stop_requested);
-    dem.run(check);
+    runStoppable(dem, check, stop_requested);
     double ref = 0.0;
     for (std::size_t i = 0; i < p.size(); ++i) ref += p.mass[i] * g * p.radius[i];
     if (p.size() == 0 || p.kineticEnergy() < fraction * ref) {
@@ -108,6 +115,7 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
   const double fall_time = g > 0.0 ? std::sqrt(2.0 * (height + 2.0 * r) / g) : 0.0;
   const double t0 = dem.time();
   const double gap = 1.02 * 2.0 * r;  // parcels start just clear of each other
+  if (o.stage_started) o.stage_started(FillStage::Inserting);
   while (result.inserted < count) {
     if (result.batches >= o.max_batches)
       throw RunError("DEM filling: " + std::to_string(count - result.inserted) + " of " +
@@ -120,9 +128,11 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
       if ((p.x[i].array() > region.lower.array() - 2 * r).all() &&
           (p.x[i].array() < region.upper.array() + 2 * r).all())
         occ.add(p.x[i]);
+    throwIfStopRequested(dem, o.stop_requested);
     long misses = 0, batch = 0;
     const long max_misses = 2000 + 20 * (count - result.inserted);
-    while (result.inserted < count && misses < max_misses) {
+    for (long attempts = 1; result.inserted < count && misses < max_misses; ++attempts) {
+      if (attempts % kInsertionAttemptsPerPoll == 0) throwIfStopRequested(dem, o.stop_requested);
       const Vector3d x = lo + (hi - lo).cwiseProduct(Vector3d(u(rng), u(rng), u(rng)));
       if (dem.walls().clearance(x) < 1.01 * r || !occ.free(x, gap)) {
         ++misses;
@@ -136,16 +146,11 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
     spdlog::debug("DEM filling: batch {} inserted {} parcels ({} of {})", result.batches, batch,
                   result.inserted, count);
     if (batch == 0 && g == 0.0) throw RunError("DEM filling: no room and no gravity to make room");
-    // Let the batch fall clear (after the last one too, so settling starts with the bed in motion),
-    // a millisecond at a time so a stop request is seen.
-    for (long left = std::max(1L, std::lround(fall_time / dem.timeStep())); left > 0;) {
-      throwIfStopRequested(dem, o.stop_requested);
-      const long chunk = std::min(left, stepsPerMillisecond(dem));
-      dem.run(chunk);
-      left -= chunk;
-    }
+    // Let the batch fall clear (after the last one too, so settling starts with the bed in motion).
+    runStoppable(dem, std::max(1L, std::lround(fall_time / dem.timeStep())), o.stop_requested);
   }
   result.fill_time = dem.time() - t0;
+  if (o.stage_started) o.stage_started(FillStage::Settling);
   result.settle_time = settle(dem, o.max_settle_time, o.settled_energy_fraction, &result.settled, o.stop_requested);
   result.kinetic_energy = dem.particles().kineticEnergy();
   spdlog::info("DEM filling: {} parcels in {} batches, {:.3f} s falling + {:.3f} s settling, {}",

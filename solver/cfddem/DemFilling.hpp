@@ -14,6 +14,12 @@
 
 namespace rcfd {
 
+/// Insertion attempts between two polls of FillOptions::stop_requested (a few milliseconds of work).
+inline constexpr long kInsertionAttemptsPerPoll = 4096;
+
+/// Inserting parcels batch by batch and letting each batch fall; then settling the whole bed.
+enum class FillStage { Inserting, Settling };
+
 struct FillRegion {
   Eigen::Vector3d lower = Eigen::Vector3d::Zero();  ///< [m]
   Eigen::Vector3d upper = Eigen::Vector3d::Zero();  ///< [m]
@@ -26,9 +32,13 @@ struct FillOptions {
   /// sqrt(2 fraction g r)) [-].
   double settled_energy_fraction = 1e-3;
   int max_batches = 200;           ///< refuse to go on when the region never takes all parcels
-  /// Polled about every millisecond of simulated time; true stops the filling with rcfd::Cancelled
-  /// (a half-filled bed is no state to resume from: the caller fills again). Empty: never.
+  /// Polled before every DEM step and every kInsertionAttemptsPerPoll insertion attempts (a step of a
+  /// large bed takes a good part of a second, a millisecond of simulated time can take minutes); true
+  /// stops the filling with rcfd::Cancelled (a half-filled bed is no state to resume from: the caller
+  /// fills again). Empty: never.
   std::function<bool()> stop_requested;
+  /// Called as the filling enters each stage (the job's progress names it). Empty: not called.
+  std::function<void(FillStage)> stage_started;
 };
 
 struct FillResult {
@@ -53,8 +63,8 @@ FillRegion defaultFillRegion(const ApparatusSpec& apparatus);
 FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count,
                          const FillOptions& options = {});
 
-/// Runs until the kinetic energy criterion holds or max_time passes; returns the time run [s].
-/// `stop_requested` as in FillOptions.
+/// Runs until the kinetic energy criterion holds (checked every millisecond of simulated time) or
+/// max_time passes; returns the time run [s]. `stop_requested` as in FillOptions.
 double settle(DemSystem& dem, double max_time, double settled_energy_fraction, bool* settled = nullptr,
               const std::function<bool()>& stop_requested = {});
 

@@ -6,6 +6,7 @@
 /// into RAM or through a bounded LRU frame cache.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,6 +64,9 @@ struct FrameStorage {
   /// With velocitySpread: a file that holds none of it is opened without it (the readers that use it
   /// when present do without it) instead of refused.
   bool velocitySpreadIfPresent = false;
+  /// Polled before each frame read into RAM (cacheBytes == 0: a long database takes minutes); true
+  /// ends the open with rcfd::Cancelled. Empty: never.
+  std::function<bool()> stopRequested = {};
 };
 
 struct FrameCacheStats {

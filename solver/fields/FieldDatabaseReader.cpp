@@ -322,7 +322,12 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
 
   if (storage.cacheBytes == 0) {
     std::vector<std::shared_ptr<const FieldFrame>> frames(std::size_t(h.frames));
-    for (int i = 0; i < h.frames; ++i) frames[std::size_t(i)] = reader->read(i);
+    for (int i = 0; i < h.frames; ++i) {
+      if (storage.stopRequested && storage.stopRequested())
+        throw Cancelled("stopped while reading " + path + " into memory (frame " + std::to_string(i) + " of " +
+                        std::to_string(h.frames) + ")");
+      frames[std::size_t(i)] = reader->read(i);
+    }
     return std::make_shared<InRamDatabase>(std::move(h), std::move(frames));  // closes the file
   }
   const int floats = kFrameFloatsPerCell + (h.velocitySpread ? kVelocitySpreadFloatsPerCell : 0);

@@ -4,6 +4,11 @@
 // spray-zone holdup and residence times; then the penalty minimum and the paper's choice of D0.
 // Finished D0 runs live in DIR/runs/d0_<i>/ (result.h5, summary.json); a re-run skips them and resumes
 // an interrupted one from its checkpoint. Aggregation: analysis/CalibrationReport.cpp.
+//
+// Cancellation (jobs/Cancellation.hpp) by phase, as the progress names them: "recurrence" (reading the
+// database, its recurrence matrix, the path) polls between frames and tiles and keeps nothing; "runs"
+// polls after every tracer step and checkpoints each unfinished run; "report" looks before it starts
+// (it reads only the runs' small result files) and keeps the runs, so a resume writes the report again.
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -99,21 +104,24 @@ class CalibrationJob final : public JobRunner {
       spdlog::warn("{}: no {} (reference statistics of the full simulation); scores that need it are not computed",
                    job.database, m);
     }
-    // One path for every D0 (the paper used a precomputed path to remove path randomness).
-    const RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed);
-
     const std::string runsDir = options.outDir + "/runs";
-    fs::create_directories(runsDir);
     double priorWall = 0.0;
     if (fs::exists(runsDir + "/prior_wall_time_s")) std::ifstream(runsDir + "/prior_wall_time_s") >> priorWall;
+    ProgressReporter progress(options.progressJson, options.progressInterval, "calibration ");
+    progress.setPriorWallTime(priorWall);
+    progress.setPhase("recurrence");
+    progress.report(0.0, 0.0, true);
+
+    // One path for every D0 (the paper used a precomputed path to remove path randomness).
+    const RecurrenceSetup rec =
+        prepareRecurrence(scene, job.database, steps + 2, job.seed, [] { return cancellationRequested(); });
+    fs::create_directories(runsDir);
 
     // --- the D0 runs ---
     std::atomic<std::int64_t> stepsThisProcess{0}, stepsDone{0};
     std::atomic<bool> stop{false};
     std::mutex mutex;  // progress reporter and the first error
     std::exception_ptr error;
-    ProgressReporter progress(options.progressJson, options.progressInterval, "calibration ");
-    progress.setPriorWallTime(priorWall);
     double totalSteps = double(steps) * double(d0.size());
 
     auto runOne = [&](std::size_t i) -> RunOutcome {
@@ -129,6 +137,10 @@ class CalibrationJob final : public JobRunner {
       if (fs::exists(dir + "/summary.json")) {
         stepsDone += steps;
         return RunOutcome::Finished;  // finished by an earlier process
+      }
+      if (cancellationRequested()) {  // not worth setting up a run only to checkpoint its first step
+        stop = true;
+        return RunOutcome::Stopped;
       }
       fs::create_directories(dir);
       writeFileAtomically(dir + "/key.json", key.dump() + "\n");
@@ -152,10 +164,14 @@ class CalibrationJob final : public JobRunner {
         if (options.stopAfterSteps >= 0 && done >= options.stopAfterSteps) stop = true;
         if (stop || cancellationRequested()) {
           stop = true;
+          const ForcedExitDeferral keepTheCheckpoint;
           sim.saveCheckpoint(checkpoint);
           return RunOutcome::Stopped;
         }
-        if (sim.currentStep() % checkpointEvery == 0 && sim.currentStep() < steps) sim.saveCheckpoint(checkpoint);
+        if (sim.currentStep() % checkpointEvery == 0 && sim.currentStep() < steps) {
+          const ForcedExitDeferral keepTheCheckpoint;
+          sim.saveCheckpoint(checkpoint);
+        }
         if (mutex.try_lock()) {
           progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt);  // summed over D0
           mutex.unlock();
@@ -206,9 +222,10 @@ class CalibrationJob final : public JobRunner {
       }
       const double wall = priorWall + progress.wallTime();
       if (error) std::rethrow_exception(error);
-      if (stop) {
+      if (stop || cancellationRequested()) {
         writeFileAtomically(runsDir + "/prior_wall_time_s", std::to_string(wall) + "\n");
-        throw Cancelled("calibration stopped; finished D0 runs and checkpoints are kept in " + runsDir);
+        throw Cancelled("calibration stopped in the " + progress.phase() +
+                        " phase; finished D0 runs and checkpoints are kept in " + runsDir);
       }
     };
 
@@ -222,8 +239,12 @@ class CalibrationJob final : public JobRunner {
     nlohmann::json summary;
     nlohmann::json extension = {{"added", nlohmann::json::array()}, {"binding_d0", bindingD0}};
     for (std::size_t first = 0;;) {
+      progress.setPhase("runs");
+      progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt, true);
       runRange(first, d0.size());
       first = d0.size();
+      progress.setPhase("report");
+      progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt, true);
       analysis::CalibrationInputs inputs{scene, *rec.database, d0, runsDir, reference, selection, steps, discardSteps};
       summary = analysis::writeCalibrationReport(inputs, options.outDir + "/result.h5",
                                                  scene.outputs.svg ? options.outDir : std::string());

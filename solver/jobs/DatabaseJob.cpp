@@ -12,6 +12,12 @@
 // Checkpoints (DIR/checkpoint.h5, every checkpoint_interval and on cancellation) hold the simulation
 // state and the job's counters; a resumed job cuts database.h5 back to the frames sampled before the
 // checkpoint and goes on from there, so it writes what an uninterrupted job writes.
+//
+// Cancellation (jobs/Cancellation.hpp) by phase, as the progress names them: "fill" and "settle" poll
+// before every DEM step and stop without a checkpoint (a half-filled bed is no state to resume from);
+// "ramp", "warmup", "sample" and "reference" poll after every coupling step and checkpoint; "results"
+// (reference series, result.h5, figures) polls between frames it reads and checkpoints the finished
+// run, so a resume only writes the results again.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -81,6 +87,14 @@ FieldFrame sampleFrame(const CfdDemSimulation& sim, bool withSpread) {
   return f;
 }
 
+/// The phase of the coupled run `offset` DEM steps after settling (the progress's "phase").
+const char* coupledPhase(const DatabaseSchedule& plan, std::int64_t offset) {
+  if (offset < plan.rampSteps) return "ramp";
+  if (offset < plan.frameOffset(0)) return "warmup";
+  if (offset < plan.frameOffset(plan.frames)) return "sample";
+  return "reference";
+}
+
 /// The job's own counters, saved beside the simulation state.
 struct JobState {
   bool settled = false;
@@ -110,6 +124,7 @@ class DatabaseJob final : public JobRunner {
     CfdDemSimulation sim(scene, job.seed);
     const std::vector<double> open = openFractions(sim.apparatus(), sim.grid());
     const std::vector<float> fluid(open.begin(), open.end());
+    if (cancellationRequested()) throw Cancelled("stopped while setting up the simulation; nothing was written");
 
     JobState st;
     std::unique_ptr<ReferenceRecorder> rec;
@@ -146,14 +161,17 @@ class DatabaseJob final : public JobRunner {
     // length does not tell how fast the coupled run goes.
     std::unique_ptr<ProgressReporter> progress;
     auto startProgress = [&] {
+      const std::string phase = progress ? progress->phase() : std::string();
       progress = std::make_unique<ProgressReporter>(options.progressJson, options.progressInterval);
       progress->setPriorWallTime(st.wallTime + elapsed());
       progress->setStartFraction(fraction());
+      progress->setPhase(phase);
     };
     startProgress();
     auto save = [&] {
       JobState now = st;
       now.wallTime = st.wallTime + elapsed();
+      const ForcedExitDeferral keepTheCheckpoint;
       saveCheckpoint(checkpoint, job, sim, now, rec.get(), coverage.get());
     };
     auto cancelled = [&](const std::string& where) {
@@ -162,23 +180,37 @@ class DatabaseJob final : public JobRunner {
     };
 
     if (!st.settled) {
+      progress->setPhase("fill");
       progress->report(0.0, sim.time(), true);
       // A stop request during the filling ends the job without a checkpoint (Cancelled, exit 130): a
-      // half-filled bed is no state to resume from, and the filling is redone from the seed.
-      st.fill = sim.fillAndSettle([] { return cancellationRequested(); });
+      // half-filled bed is no state to resume from, and the filling is redone from the seed. The poll
+      // before every DEM step also keeps the progress going (a large bed fills for hours).
+      st.fill = sim.fillAndSettle(
+          [&] {
+            progress->report(0.0, sim.dem().time());
+            return cancellationRequested();
+          },
+          [&](FillStage stage) {
+            progress->setPhase(stage == FillStage::Inserting ? "fill" : "settle");
+            progress->report(0.0, sim.dem().time());
+          });
       st.settled = true;
       st.settledStep = sim.demStep();
       makeRecorder();
       FieldDatabaseWriterOptions writeOptions;
       writeOptions.velocitySpread = TracerEffectRegistry::needsVelocitySpread(scene.effects);
-      writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(), scene.source_json,
-                                                     writeOptions);
+      {
+        const ForcedExitDeferral keepTheDatabaseReadable;
+        writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(),
+                                                       scene.source_json, writeOptions);
+      }
       progress->report(fraction(), sim.time(), true);
       startProgress();
       if (cancellationRequested() || options.stopAfterSteps == 0) cancelled("after settling");
       // The filling is the longest stretch without one (an hour on the ProCell bed): keep it at once.
       save();
     } else {
+      const ForcedExitDeferral keepTheDatabaseReadable;
       writer = FieldDatabaseWriter::reopen(databasePath, sim.grid(), int(st.framesWritten));
     }
 
@@ -189,8 +221,11 @@ class DatabaseJob final : public JobRunner {
     while (true) {
       // Events at the current instant first: a checkpoint taken after a step resumes here.
       const std::int64_t offset = sim.demStep() - st.settledStep;
+      progress->setPhase(coupledPhase(plan, offset));
       if (st.framesWritten < plan.frames && offset == plan.frameOffset(st.framesWritten)) {
-        writer->append(sampleFrame(sim, writer->writesVelocitySpread()));
+        const FieldFrame frame = sampleFrame(sim, writer->writesVelocitySpread());
+        const ForcedExitDeferral keepTheDatabaseReadable;
+        writer->append(frame);
         ++st.framesWritten;
       }
       if (rec->samples() < totalSamples && offset == plan.sampleOffset(rec->samples())) {
@@ -220,21 +255,25 @@ class DatabaseJob final : public JobRunner {
       ++st.couplingSteps;
       const bool stopForTest =
           options.stopAfterSteps >= 0 && st.couplingSteps - firstCouplingStep >= options.stopAfterSteps;
-      if (cancellationRequested() || stopForTest) cancelled("at coupling step " + std::to_string(st.couplingSteps));
+      if (cancellationRequested() || stopForTest) {
+        cancelled("in the " + progress->phase() + " phase at coupling step " + std::to_string(st.couplingSteps));
+      }
       if (sim.demStep() - lastCheckpoint >= checkpointEvery) {
         save();
         lastCheckpoint = sim.demStep();
       }
       progress->report(fraction(), sim.time());
     }
-    writer->close();
+    progress->setPhase("results");
+    progress->report(1.0, sim.time(), true);
     {
+      const ForcedExitDeferral keepTheDatabaseReadable;
+      writer->close();
       h5::File db(databasePath, h5::File::Mode::ReadWrite);
       rec->write(db);
       if (coverage) coverage->write(db);
       db.flush();
     }
-    progress->report(1.0, sim.time(), true);
 
     const double wall = st.wallTime + elapsed();
     const std::size_t parcels = sim.dem().particles().size();
@@ -273,7 +312,12 @@ class DatabaseJob final : public JobRunner {
                            {"speed_to_reach_top_m_per_s", (chamberTop - st.highestParcelTop) / plan.sampleDt()},
                            {"parcels_reaching_top", nearTop},
                            {"fraction_reaching_top", double(nearTop) / double(std::max<std::size_t>(1, parcels))}};
-    writeResultAndFigures(scene, databasePath, options.outDir, *rec, summary);
+    try {
+      writeResultAndFigures(scene, databasePath, options.outDir, *rec, summary, [] { return cancellationRequested(); });
+    } catch (const Cancelled&) {
+      // The run is complete: a checkpoint of its end leaves a resume only the results to write.
+      cancelled("while writing the results");
+    }
     // Wall time and rates describe this machine, not the physics: the only keys allowed to differ
     // between otherwise bit-identical runs.
     summary["wall_time_s"] = wall;
@@ -333,10 +377,12 @@ class DatabaseJob final : public JobRunner {
     sim.loadState(f, "/simulation");
   }
 
+  /// result.h5 and the figures; rcfd::Cancelled as soon as `stopRequested` says so.
   static void writeResultAndFigures(const Scene& scene, const std::string& databasePath, const std::string& outDir,
-                                    const ReferenceRecorder& rec, nlohmann::json& summary) {
+                                    const ReferenceRecorder& rec, nlohmann::json& summary,
+                                    const std::function<bool()>& stopRequested) {
     auto db = FieldDatabase::open(databasePath, FrameStorage{kFigureCacheBytes});
-    const std::vector<double> mean = analysis::meanAlphaP(*db);
+    const std::vector<double> mean = analysis::meanAlphaP(*db, stopRequested);
     nlohmann::json probes = nlohmann::json::array();
     for (const auto& p : scene.probes) {
       probes.push_back({{"name", p.name}, {"alpha_p_mean", mean[std::size_t(db->grid().flatIndexOf(p.position))]}});
@@ -352,11 +398,12 @@ class DatabaseJob final : public JobRunner {
       out.flush();
     }
     fs::rename(outDir + "/result.h5.tmp", outDir + "/result.h5");
+    if (stopRequested()) throw Cancelled("stopped before drawing the figures");
     if (scene.outputs.svg) {
       analysis::PressureDropSeries dp{rec.pressureDrop(), rec.dt(), 0.0, std::nullopt};
       const auto& f = summary["pressure_drop"]["dominant_frequency_hz"];
       if (f.is_number()) dp.dominantFrequency = f.get<double>();
-      summary["figures"] = analysis::writeDatabaseFigures(scene, *db, dp, outDir);
+      summary["figures"] = analysis::writeDatabaseFigures(scene, *db, dp, outDir, stopRequested);
     }
   }
 };

@@ -23,7 +23,7 @@ class JobRunner {
  public:
   virtual ~JobRunner() = default;
   /// Runs the job; returns the summary written to summary.json. Throws InputError, RunError or
-  /// Cancelled (after writing a checkpoint).
+  /// Cancelled (after writing a checkpoint where the phase it stopped in has one).
   virtual nlohmann::json run(const JobSpec& job, const RunOptions& options) = 0;
 };
 

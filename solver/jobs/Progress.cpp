@@ -21,23 +21,32 @@ double ProgressReporter::wallTime() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+void ProgressReporter::setPhase(std::string phase) {
+  if (phase == phase_) return;
+  phase_ = std::move(phase);
+  phaseReported_ = false;
+}
+
 void ProgressReporter::report(double fraction, double simTime, bool force) {
   const double now = wallTime();
-  if (!force && now - lastReport_ < interval_) return;
+  if (!force && phaseReported_ && now - lastReport_ < interval_) return;
   lastReport_ = now;
+  phaseReported_ = true;
   const double eta = eta_.update(now, fraction);
   const double wall = prior_ + now;
   if (json_) {
     nlohmann::json line = {{"fraction", fraction}, {"sim_time", simTime}, {"wall_time", wall},
                            {"eta_s", eta >= 0.0 ? nlohmann::json(eta) : nlohmann::json(nullptr)}};
+    if (!phase_.empty()) line["phase"] = phase_;
     std::printf("%s\n", line.dump().c_str());
     std::fflush(stdout);
   }
+  const std::string label = label_ + (phase_.empty() ? "" : phase_ + " ");
   if (eta >= 0.0) {
-    std::fprintf(stderr, "%s%5.1f%%  t = %.3f s  wall %.1f s  eta %.0f s\n", label_.c_str(), 100.0 * fraction,
+    std::fprintf(stderr, "%s%5.1f%%  t = %.3f s  wall %.1f s  eta %.0f s\n", label.c_str(), 100.0 * fraction,
                  simTime, wall, eta);
   } else {
-    std::fprintf(stderr, "%s%5.1f%%  t = %.3f s  wall %.1f s\n", label_.c_str(), 100.0 * fraction, simTime, wall);
+    std::fprintf(stderr, "%s%5.1f%%  t = %.3f s  wall %.1f s\n", label.c_str(), 100.0 * fraction, simTime, wall);
   }
 }
 

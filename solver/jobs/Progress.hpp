@@ -1,9 +1,9 @@
 #pragma once
 /// \file Progress.hpp
 /// Progress of a running job: a human line on stderr and, with --progress-json, one JSON object per line
-/// on stdout ({"fraction","sim_time","wall_time","eta_s"}, CONTRACTS.md) -- what the server's workers
-/// read. Throttled to about one report per `interval` seconds of wall time. The ETA uses the rate of
-/// the last minute (EtaEstimate).
+/// on stdout ({"fraction","sim_time","wall_time","eta_s"} and, once the job names it, "phase";
+/// CONTRACTS.md) -- what the server's workers read. Throttled to about one report per `interval`
+/// seconds of wall time. The ETA uses the rate of the last minute (EtaEstimate).
 
 #include <chrono>
 #include <deque>
@@ -44,11 +44,18 @@ class ProgressReporter {
   void setPriorWallTime(double seconds) { prior_ = seconds; }
   /// Fraction already done when this process started (so the ETA uses this process's rate only).
   void setStartFraction(double fraction) { eta_.restart(wallTime(), fraction); }
+  /// Names the phase the job is in ("fill", "sample", "recurrence", ...): the "phase" of every later
+  /// report. A new phase is reported at the next report() whatever the interval, so a reader sees it
+  /// as soon as it starts.
+  void setPhase(std::string phase);
+  const std::string& phase() const { return phase_; }
 
  private:
   bool json_;
   double interval_;
   std::string label_;
+  std::string phase_;
+  bool phaseReported_ = true;
   double prior_ = 0.0;
   std::chrono::steady_clock::time_point start_;
   double lastReport_ = -1e300;

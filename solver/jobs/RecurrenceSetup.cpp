@@ -5,12 +5,13 @@
 #include <limits>
 
 #include "core/Errors.hpp"
+#include "jobs/Cancellation.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
 
 RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databasePath, std::int64_t frames,
-                                  std::uint64_t seed) {
+                                  std::uint64_t seed, const std::function<bool()>& stopRequested) {
   RecurrenceSetup setup;
   {
     // Peek at the frame count first: the matrix must be stored while no reader holds the file.
@@ -24,16 +25,20 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
     }
   }
   const FrameStorage storage{scene.rcfd.frame_cache_bytes, TracerEffectRegistry::needsVelocitySpread(scene.effects),
-                             !TracerEffectRegistry::requiresVelocitySpread(scene.effects)};
+                             !TracerEffectRegistry::requiresVelocitySpread(scene.effects), stopRequested};
   setup.database = FieldDatabase::open(databasePath, storage);
   if (!setup.matrixWasStored) {
-    setup.matrix = computeRecurrenceMatrix(*setup.database);
+    RecurrenceOptions options;
+    options.stopRequested = stopRequested;
+    setup.matrix = computeRecurrenceMatrix(*setup.database, options);
     spdlog::info("recurrence matrix of {} frames computed in {:.2f} s", setup.database->frameCount(),
                  setup.matrix.seconds);
     try {
       auto reopen = setup.database;
       setup.database.reset();
       reopen.reset();
+      // Written into the database in place: a forced exit must not cut it (jobs/Cancellation.hpp).
+      const ForcedExitDeferral keepTheDatabaseReadable;
       storeRecurrenceMatrix(databasePath, setup.matrix);
     } catch (const std::exception& e) {
       spdlog::warn("could not store the recurrence matrix in {}: {}", databasePath, e.what());
@@ -43,6 +48,7 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
   if (!PathGeneratorRegistry::contains(scene.rcfd.path.type)) {
     throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));
   }
+  if (stopRequested && stopRequested()) throw Cancelled("stopped before building the recurrence path");
   auto generator = PathGeneratorRegistry::create(scene.rcfd.path.type, scene.rcfd.path);
   setup.path = generator->generate(setup.matrix.R, frames, seed);
   setup.pathStats = pathStatistics(setup.path, setup.matrix.R);

@@ -4,6 +4,7 @@
 /// scene's frame storage, its recurrence matrix (read from the file when stored, computed and stored
 /// otherwise) and the recurrence path the scene asks for.
 
+#include <functional>
 #include <memory>
 
 #include "fields/FieldDatabase.hpp"
@@ -22,7 +23,9 @@ struct RecurrenceSetup {
 };
 
 /// Opens `databasePath`, gets its recurrence matrix and builds a path of at least `frames` entries.
+/// `stopRequested` is polled (from several threads) between the frames read and the matrix's tiles:
+/// true ends the setup with rcfd::Cancelled, leaving the database file as it was.
 RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databasePath, std::int64_t frames,
-                                  std::uint64_t seed);
+                                  std::uint64_t seed, const std::function<bool()>& stopRequested = {});
 
 }  // namespace rcfd

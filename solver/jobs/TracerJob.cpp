@@ -1,6 +1,11 @@
 // The "spray" job: a tracer simulation with the scene's effects on an existing database, for
 // `duration` simulated seconds, with checkpoints, resume and progress. (Spray deposition itself plugs in
 // as further effects.)
+//
+// Cancellation (jobs/Cancellation.hpp) by phase, as the progress names them: "recurrence" (reading the
+// database, its recurrence matrix, the path) polls between frames and tiles and keeps nothing; "run"
+// polls after every tracer step and checkpoints; "results" looks between its parts and checkpoints the
+// finished run, so a resume only writes the results again.
 #include <chrono>
 #include <filesystem>
 #include <spdlog/spdlog.h>
@@ -69,44 +74,60 @@ class TracerJob final : public JobRunner {
     requireJobRules(job);
     const std::int64_t steps = std::llround(job.duration / scene.rcfd.dt);
 
-    // The path is indexed per frame; dt may divide dt_rec, so size it for the number of frames used.
-    RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed);
-    TracerRunSettings settings{job.seed, steps, 0};
-    TracerSimulation sim(scene, rec.database, rec.path, settings);
-
     const std::string checkpoint = options.outDir + "/checkpoint.h5";
     double priorWall = 0.0;
     if (std::filesystem::exists(checkpoint)) {
-      sim.loadCheckpoint(checkpoint);
       h5::File f(checkpoint, h5::File::Mode::ReadOnly);
       if (f.exists("/state/wall_time")) priorWall = f.readDoubles("/state/wall_time").at(0);
+    }
+    ProgressReporter progress(options.progressJson, options.progressInterval);
+    progress.setPriorWallTime(priorWall);
+    progress.setPhase("recurrence");
+    progress.report(0.0, 0.0, true);
+
+    // The path is indexed per frame; dt may divide dt_rec, so size it for the number of frames used.
+    RecurrenceSetup rec =
+        prepareRecurrence(scene, job.database, steps + 2, job.seed, [] { return cancellationRequested(); });
+    TracerRunSettings settings{job.seed, steps, 0};
+    TracerSimulation sim(scene, rec.database, rec.path, settings);
+    if (std::filesystem::exists(checkpoint)) {
+      sim.loadCheckpoint(checkpoint);
       spdlog::info("resumed from {} at step {} of {}", checkpoint, sim.currentStep(), steps);
     }
     const std::int64_t checkpointEvery =
         std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / scene.rcfd.dt));
 
-    ProgressReporter progress(options.progressJson, options.progressInterval);
-    progress.setPriorWallTime(priorWall);
     progress.setStartFraction(double(sim.currentStep()) / double(steps));
+    progress.setPhase("run");
+    progress.report(double(sim.currentStep()) / double(steps), sim.time(), true);
     auto save = [&] {
+      // The wall time goes into the checkpoint in place: a forced exit must not cut either write.
+      const ForcedExitDeferral keepTheCheckpoint;
       sim.saveCheckpoint(checkpoint);
       h5::File f(checkpoint, h5::File::Mode::ReadWrite);
       f.write("/state/wall_time", std::vector<double>{priorWall + progress.wallTime()});
     };
+    auto cancelled = [&](const std::string& where) {
+      save();
+      throw Cancelled("stopped " + where + " at step " + std::to_string(sim.currentStep()) + " of " +
+                      std::to_string(steps) + "; checkpoint " + checkpoint);
+    };
     const std::int64_t firstStep = sim.currentStep();
     while (sim.currentStep() < steps) {
+      if (cancellationRequested()) cancelled("in the run phase");  // e.g. while the tracers were placed
       sim.step();
       const std::int64_t s = sim.currentStep();
       const bool stopForTest = options.stopAfterSteps >= 0 && s - firstStep >= options.stopAfterSteps;
-      if (cancellationRequested() || stopForTest) {
-        save();
-        throw Cancelled("stopped at step " + std::to_string(s) + " of " + std::to_string(steps) +
-                        "; checkpoint " + checkpoint);
-      }
+      if (cancellationRequested() || stopForTest) cancelled("in the run phase");
       if (s % checkpointEvery == 0 && s < steps) save();
       progress.report(double(s) / double(steps), sim.time());
     }
+    progress.setPhase("results");
     progress.report(1.0, sim.time(), true);
+    // The run is complete: a checkpoint of its end leaves a resume only the results to write.
+    auto pollInResults = [&] {
+      if (cancellationRequested()) cancelled("while writing the results");
+    };
 
     const double wall = priorWall + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
     nlohmann::json summary = {{"kind", job.kind},
@@ -116,6 +137,7 @@ class TracerJob final : public JobRunner {
                               {"sim_time_s", sim.time()},
                               {"dt", scene.rcfd.dt},
                               {"effects", sim.effectNames()}};
+    pollInResults();
     {
       const std::string resultTmp = options.outDir + "/result.h5.tmp";
       h5::File out(resultTmp, h5::File::Mode::Create);
@@ -125,9 +147,11 @@ class TracerJob final : public JobRunner {
       out.flush();
     }
     std::filesystem::rename(options.outDir + "/result.h5.tmp", options.outDir + "/result.h5");
+    pollInResults();
     summary["stay_comparison"] = stayComparison(job, scene, options.outDir + "/result.h5", steps);
     summary["coverage_comparison"] = coverageComparison(job, scene, options.outDir + "/result.h5",
                                                         sim.cloud().particlesPerTracer, sim.time());
+    pollInResults();
     if (scene.outputs.svg) summary["figures"] = sim.writeFigures(options.outDir);
     summary["path"] = {{"jumps", rec.pathStats.jumps},
                        {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},

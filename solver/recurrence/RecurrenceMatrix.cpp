@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -69,6 +70,27 @@ ScalarSeries scalarSeries(const FieldDatabase& db, const FieldComponent& field) 
 
 namespace {
 
+/// A stop request seen from inside parallel loops: the first true answer is kept, every later poll
+/// skips its work at once, and the caller throws after the loop (exceptions must not leave an OpenMP
+/// region).
+class StopPoll {
+ public:
+  explicit StopPoll(const std::function<bool()>& request) : request_(request) {}
+  bool operator()() const {
+    if (stopped_.load(std::memory_order_relaxed)) return true;
+    if (!request_ || !request_()) return false;
+    stopped_.store(true, std::memory_order_relaxed);
+    return true;
+  }
+  void throwIfStopped() const {
+    if (stopped_.load()) throw Cancelled("stopped while computing the recurrence matrix; nothing of it is kept");
+  }
+
+ private:
+  const std::function<bool()>& request_;
+  mutable std::atomic<bool> stopped_{false};
+};
+
 struct Tile {
   int first, count;
 };
@@ -83,7 +105,7 @@ std::vector<Tile> tiles(int first, int count, int size) {
 // that fails to load (e.g. NaN found by a cached database) throws after the parallel loop: exceptions
 // must not leave an OpenMP region.
 template <class Store>
-void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
+void loadFrames(const ScalarSeries& s, int first, int count, Store store, const StopPoll& stop) {
   const std::size_t cells = s.weights.size();
   std::exception_ptr failure;
   // Small loads stay on one thread: an OpenMP region costs more than it saves when cores are shared.
@@ -92,6 +114,7 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
     std::vector<float> buffer(cells);
 #pragma omp for schedule(dynamic, 1)
     for (int f = 0; f < count; ++f) {
+      if (stop()) continue;
       try {
         s.fetch(first + f, buffer.data());
         store(f, buffer);
@@ -102,6 +125,7 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
     }
   }
   if (failure) std::rethrow_exception(failure);
+  stop.throwIfStopped();
 }
 
 // Gram form of the L2 distances. Frames are centred on frame 0 (D is unchanged, (a_i - r) - (a_j - r)
@@ -110,7 +134,8 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store) {
 // `floatChunk` cells, each chunk's partial sums added in double, so rounding grows with the chunk, not
 // with the cell count (docs/performance.md compares both).
 template <class Scalar>
-Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileFrames, std::int64_t* clamped) {
+Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileFrames, std::int64_t* clamped,
+                            const StopPoll& stop) {
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   constexpr Eigen::Index floatChunk = 512;
   const int n = s.frames;
@@ -132,7 +157,7 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
         squared += double(col[c]) * double(col[c]);  // n_i in double from the stored values
       }
       norms[first + f] = squared;
-    });
+    }, stop);
   };
 
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);  // upper triangle filled
@@ -153,6 +178,7 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
       // on or above the diagonal are computed.
 #pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
       for (int k = 0; k < int(pairs.size()); ++k) {
+        if (stop()) continue;
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
         auto target = G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count);
@@ -160,13 +186,15 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
           target.noalias() = XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
         } else {
           Eigen::MatrixXf partial(a.count, b.count);
-          for (Eigen::Index c0 = 0; c0 < cells; c0 += floatChunk) {
+          // Polled per chunk too: one tile over 10^6 cells takes seconds.
+          for (Eigen::Index c0 = 0; c0 < cells && !stop(); c0 += floatChunk) {
             const Eigen::Index len = std::min(floatChunk, cells - c0);
             partial.noalias() = XP.block(c0, a.first, len, a.count).transpose() * Y.block(c0, b.first, len, b.count);
             target += partial.cast<double>();
           }
         }
       }
+      stop.throwIfStopped();
     }
   }
   std::int64_t negatives = 0;
@@ -193,7 +221,8 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
 
 // L1 (volume-weighted sum of |a_i - a_j|) and max (largest |a_i - a_j|) by a direct loop, blocked over
 // frames (memory) and cells (cache).
-Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int framesPerBlock, int tileFrames) {
+Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int framesPerBlock, int tileFrames,
+                                const StopPoll& stop) {
   const int n = s.frames;
   const Eigen::Index cells = Eigen::Index(s.weights.size());
   const double* w = s.weights.data();
@@ -203,7 +232,7 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
     X.resize(cells, count);
     loadFrames(s, first, count, [&](int f, const std::vector<float>& v) {
       std::copy(v.begin(), v.end(), X.col(f).data());
-    });
+    }, stop);
   };
   Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
   const auto blocks = tiles(0, n, framesPerBlock);
@@ -221,6 +250,7 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
         for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
 #pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
       for (int k = 0; k < int(pairs.size()); ++k) {
+        if (stop()) continue;
         const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
         const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
         Eigen::MatrixXd acc = Eigen::MatrixXd::Zero(a.count, b.count);
@@ -254,6 +284,7 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
             if (gj > gi) D(gi, gj) = D(gj, gi) = acc(i, j);
           }
       }
+      stop.throwIfStopped();
     }
   }
   return D;
@@ -263,7 +294,8 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
 
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames, int* blocks,
-                               std::int64_t* clamped, GramPrecision precision) {
+                               std::int64_t* clamped, GramPrecision precision,
+                               const std::function<bool()>& stopRequested) {
   const int n = series.frames;
   if (n < 1 || series.weights.empty()) {
     throw InputError("recurrence", "/frames", "no frames or no open cells to compare");
@@ -279,11 +311,13 @@ Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
   const int framesPerBlock = int(std::min<std::int64_t>(n, perBlock));
   if (blocks) *blocks = (n + framesPerBlock - 1) / framesPerBlock;
   if (clamped) *clamped = 0;
+  const StopPoll stop(stopRequested);
   if (norm == RecurrenceNorm::L2) {
-    return precision == GramPrecision::FloatChunked ? l2Distances<float>(series, framesPerBlock, tileFrames, clamped)
-                                                    : l2Distances<double>(series, framesPerBlock, tileFrames, clamped);
+    return precision == GramPrecision::FloatChunked
+               ? l2Distances<float>(series, framesPerBlock, tileFrames, clamped, stop)
+               : l2Distances<double>(series, framesPerBlock, tileFrames, clamped, stop);
   }
-  return directDistances(series, norm, framesPerBlock, tileFrames);
+  return directDistances(series, norm, framesPerBlock, tileFrames, stop);
 }
 
 RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D) {
@@ -303,7 +337,8 @@ namespace {
 
 // Largest |R(i, j) - R_exact(i, j)| over `pairs` seeded random entries and the most distant pair, with
 // R_exact from Eq. (6) summed in double straight from the frames (normalised by m's max D).
-double spotCheck(const ScalarSeries& s, const RecurrenceMatrix& m, int pairs) {
+double spotCheck(const ScalarSeries& s, const RecurrenceMatrix& m, int pairs,
+                 const std::function<bool()>& stopRequested) {
   const int n = s.frames;
   std::vector<std::pair<int, int>> entries;
   Eigen::Index fi = 0, fj = 0;
@@ -315,7 +350,9 @@ double spotCheck(const ScalarSeries& s, const RecurrenceMatrix& m, int pairs) {
   const std::size_t cells = s.weights.size();
   double worst = 0.0;
   std::vector<float> a(cells), b(cells);
+  const StopPoll stop(stopRequested);
   for (const auto& [i, j] : entries) {
+    if (stop()) stop.throwIfStopped();
     s.fetch(i, a.data());
     s.fetch(j, b.data());
     double d = 0.0;
@@ -332,8 +369,8 @@ double spotCheck(const ScalarSeries& s, const RecurrenceMatrix& m, int pairs) {
 RecurrenceMatrix computeOnce(const ScalarSeries& series, const RecurrenceOptions& options, GramPrecision gram) {
   int blocks = 1;
   std::int64_t clamped = 0;
-  const Eigen::MatrixXd D =
-      distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames, &blocks, &clamped, gram);
+  const Eigen::MatrixXd D = distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames,
+                                           &blocks, &clamped, gram, options.stopRequested);
   RecurrenceMatrix m = normaliseDistances(D);
   m.norm = options.norm;
   m.field = options.field;
@@ -352,7 +389,7 @@ RecurrenceMatrix computeRecurrenceMatrix(const ScalarSeries& series, const Recur
     m = computeOnce(series, options, options.gram == GramPrecision::Auto ? GramPrecision::Double : options.gram);
   } else {
     m = computeOnce(series, options, GramPrecision::FloatChunked);
-    m.spotCheckError = spotCheck(series, m, options.autoCheckPairs);
+    m.spotCheckError = spotCheck(series, m, options.autoCheckPairs, options.stopRequested);
     if (!(m.spotCheckError <= options.autoTolerance)) {
       const double failedError = m.spotCheckError;
       m = computeOnce(series, options, GramPrecision::Double);

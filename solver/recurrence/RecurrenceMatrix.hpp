@@ -74,6 +74,10 @@ struct RecurrenceOptions {
   GramPrecision gram = GramPrecision::Auto;
   int autoCheckPairs = 64;       ///< Auto: random entries checked against exact double sums
   double autoTolerance = 3e-7;   ///< Auto: largest accepted |R - R_exact| in the check (target 1e-6)
+  /// Polled before every frame loaded and every tile computed, from several threads (so it must be
+  /// thread-safe); true ends the computation with rcfd::Cancelled. A long database's matrix takes
+  /// minutes. Empty: never.
+  std::function<bool()> stopRequested = {};
 };
 
 struct RecurrenceMatrix {
@@ -90,11 +94,12 @@ struct RecurrenceMatrix {
 };
 
 /// D(i, j) (before normalisation) for the series; `blocks` and `clamped` report the blocking and the
-/// negative round-off values clamped to 0.
+/// negative round-off values clamped to 0; `stopRequested` as in RecurrenceOptions.
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames = 128,
                                int* blocks = nullptr, std::int64_t* clamped = nullptr,
-                               GramPrecision precision = GramPrecision::Double);
+                               GramPrecision precision = GramPrecision::Double,
+                               const std::function<bool()>& stopRequested = {});
 
 /// Eq. (6)-(7) from a distance matrix: R = 1 - D / max D (all ones if every D is 0).
 RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D);

@@ -69,9 +69,10 @@ TEST(Bed, PouredBedPacksBetween058And064) {
   EXPECT_LT(phi, 0.64);
 }
 
-TEST(Bed, AStopRequestEndsTheFillingWithinAMillisecondOfSimulatedTime) {
-  // A cancelled database job must not wait for the whole filling (~40 s of wall time for quick.json):
-  // the stop request is polled every millisecond of simulated time, while batches fall and settle.
+TEST(Bed, AStopRequestEndsTheFillingAtTheNextDemStep) {
+  // A cancelled database job must not wait for the whole filling (~40 s of wall time for quick.json,
+  // hours for a large bed, where even a millisecond of simulated time takes minutes): the stop request
+  // is polled before every DEM step, while batches fall and while the bed settles.
   const double r = 1.5e-3;
   const DemMaterial m = material(r, 0.9, 0.75, 0.5, 0.24, 0.06, 0.05, 5e5, 1040.0);
   DemSettings s;
@@ -79,17 +80,44 @@ TEST(Bed, AStopRequestEndsTheFillingWithinAMillisecondOfSimulatedTime) {
   const Vector3d lo(-0.015, 0.0, 0.0), hi(0.015, 0.15, 0.03);
   DemSystem dem(m, DemWalls::box(lo, hi), s);
   FillOptions o;
-  int polls = 0;
-  o.stop_requested = [&] { return ++polls > 20; };  // after 20 ms of falling
+  std::vector<FillStage> stages;
+  o.stage_started = [&](FillStage stage) { stages.push_back(stage); };
+  o.stop_requested = [&] { return dem.time() >= 0.020; };  // after 20 ms of falling
   EXPECT_THROW(fillAndSettle(dem, FillRegion{Vector3d(lo.x(), 0.05, lo.z()), hi}, 1500, o), Cancelled);
-  EXPECT_EQ(polls, 21);
-  EXPECT_LE(dem.time(), 0.020 + 1e-3 + 1e-12);
-  EXPECT_GT(dem.time(), 0.015);  // chunks of whole DEM steps just under a millisecond
-  // Without a request the same call fills everything (the first batch alone takes 0.15 s to fall).
+  EXPECT_GE(dem.time(), 0.020);
+  EXPECT_LT(dem.time(), 0.020 + s.time_step + 1e-12);
+  EXPECT_EQ(stages, std::vector<FillStage>{FillStage::Inserting});
+  // While settling too: the first batch alone takes 0.15 s to fall, so settling starts near 0.2 s.
+  DemSystem settling(m, DemWalls::box(lo, hi), s);
+  stages.clear();
+  o.stop_requested = [&] { return !stages.empty() && stages.back() == FillStage::Settling; };
+  EXPECT_THROW(fillAndSettle(settling, FillRegion{Vector3d(lo.x(), 0.05, lo.z()), hi}, 200, o), Cancelled);
+  EXPECT_EQ(stages, (std::vector<FillStage>{FillStage::Inserting, FillStage::Settling}));
+  // Without a request the same call fills everything.
   DemSystem full(m, DemWalls::box(lo, hi), s);
   o.stop_requested = [] { return false; };
   o.max_settle_time = 0.01;
   EXPECT_EQ(fillAndSettle(full, FillRegion{Vector3d(lo.x(), 0.05, lo.z()), hi}, 200, o).inserted, 200);
+}
+
+TEST(Bed, AStopRequestEndsTheInsertionOfALargeBatch) {
+  // Inserting the parcels of a large bed is itself long (a million random positions, each tested
+  // against the walls and its neighbours): the request is polled every kInsertionAttemptsPerPoll
+  // attempts, before a single DEM step.
+  const double r = 1.5e-3;
+  const DemMaterial m = material(r, 0.9, 0.75, 0.5, 0.24, 0.06, 0.05, 5e5, 1040.0);
+  DemSettings s;
+  s.time_step = 0.25 * m.rayleighTime();
+  const Vector3d lo(-0.15, 0.0, 0.0), hi(0.15, 0.6, 0.15);
+  DemSystem dem(m, DemWalls::box(lo, hi), s);
+  FillOptions o;
+  int polls = 0;
+  o.stop_requested = [&] { return ++polls > 3; };  // the batch's start, then after 4096 and 8192 attempts
+  EXPECT_THROW(fillAndSettle(dem, FillRegion{Vector3d(lo.x(), 0.3, lo.z()), hi}, 100000, o), Cancelled);
+  EXPECT_EQ(polls, 4);
+  EXPECT_EQ(dem.steps(), 0);
+  EXPECT_GT(dem.particles().size(), 0u);
+  EXPECT_LE(dem.particles().size(), std::size_t(3 * kInsertionAttemptsPerPoll));
 }
 
 TEST(Bed, ProCellSettlesIntoTheVWithNothingOutside) {

@@ -452,3 +452,16 @@ TEST(FieldDatabase, AVelocitySpreadOutOfRangeIsRefusedNamingTheDataset) {
   frames[2].u_p_up.clear();  // part of the spread missing
   EXPECT_THROW(makeInMemoryDatabase(g, variedFluid(g), 0.005, frames), InputError);
 }
+
+TEST(FieldDatabase, AStopRequestEndsReadingIntoRamBetweenFrames) {
+  // All frames into RAM takes minutes for a long database: a cancelled job is asked before each.
+  const CartesianGrid g = smallGrid(4, 3, 2);
+  const std::string path = writeWavyDatabase("stopped-read.h5", g, 6, 0.005);
+  FrameStorage storage;
+  int polls = 0;
+  storage.stopRequested = [&] { return ++polls > 3; };
+  EXPECT_THROW(FieldDatabase::open(path, storage), Cancelled);
+  EXPECT_EQ(polls, 4);  // frames 0-2 read, stopped before frame 3
+  storage.stopRequested = [] { return false; };
+  EXPECT_EQ(FieldDatabase::open(path, storage)->frameCount(), 6);
+}

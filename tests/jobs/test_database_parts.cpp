@@ -249,6 +249,10 @@ TEST(DatabaseFigures, SnapshotsTimeAverageAndPressureDrop) {
     }
   });
   const auto mean = rcfd::analysis::meanAlphaP(*db);
+  // A stop request is asked before every frame (the results of a long database job read minutes).
+  int polls = 0;
+  EXPECT_THROW(rcfd::analysis::meanAlphaP(*db, [&] { return ++polls > 2; }), rcfd::Cancelled);
+  EXPECT_EQ(polls, 3);
   // Row j is filled in the frames n >= j - 4 of 0..8: 9 - max(0, j - 4) of the 9 frames.
   for (int j = 0; j < grid.shape[1]; ++j) {
     const double filled = std::clamp(double(9 - std::max(0, j - 4)), 0.0, 9.0) / 9.0;

@@ -1,8 +1,12 @@
 // Recurrence matrix (Eq. 6-7): Gram form against a naive double loop, blocking, norms, properties,
 // periodic fields, storage in the database.
 #include <gtest/gtest.h>
+#include <omp.h>
+
+#include <atomic>
 
 #include "../fields/FieldTestUtil.hpp"
+#include "core/Errors.hpp"
 #include "recurrence/RecurrenceMatrix.hpp"
 #include "recurrence/RecurrencePlot.hpp"
 
@@ -249,4 +253,28 @@ TEST(RecurrenceMatrix, FrameCacheGivesTheSameMatrixAsRam) {
   const RecurrenceMatrix a = computeRecurrenceMatrix(*ram, o), b = computeRecurrenceMatrix(*cached, o);
   EXPECT_EQ(a.R, b.R);
   EXPECT_GT(cached->cacheStats().misses, 25);  // blocks re-read frames evicted from the 4-frame cache
+}
+
+TEST(RecurrenceMatrix, AStopRequestEndsItBetweenTilesForEveryNormAndPrecision) {
+  // A long database's matrix takes minutes: a cancelled job must not wait for it. The request is
+  // polled once per frame loaded and then per tile (and per cell chunk of a float tile); the first
+  // true answer ends the computation with rcfd::Cancelled after the parallel loop it came in.
+  const int frames = 200;
+  auto db = wavyDb(frames);
+  for (const auto& [norm, gram] : {std::pair{RecurrenceNorm::L2, GramPrecision::Double},
+                                   std::pair{RecurrenceNorm::L2, GramPrecision::Auto},
+                                   std::pair{RecurrenceNorm::L1, GramPrecision::Double}}) {
+    std::atomic<int> polls{0};
+    RecurrenceOptions o;
+    o.norm = norm;
+    o.gram = gram;
+    o.tileFrames = 8;  // 325 tile pairs
+    o.stopRequested = [&] { return ++polls > frames + 5; };  // every frame loaded, then a few tiles
+    EXPECT_THROW(computeRecurrenceMatrix(*db, o), Cancelled) << toString(norm);
+    // Once seen, the request is not asked again: at most one more poll per thread already past it.
+    EXPECT_LE(polls.load(), frames + 6 + omp_get_max_threads()) << toString(norm);
+    // Without a request the same options give the whole matrix.
+    o.stopRequested = [] { return false; };
+    EXPECT_EQ(computeRecurrenceMatrix(*db, o).R.rows(), frames) << toString(norm);
+  }
 }

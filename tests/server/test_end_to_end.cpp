@@ -417,6 +417,46 @@ TEST_F(EndToEnd, ASolverThatIgnoresItsCancelIsKilledAfterTheGracePeriod) {
   EXPECT_TRUE(killed) << events.dump(2);
 }
 
+// A database job cancelled while its solver fills a large bed (23,000 parcels at dt_DEM = 1 us, minutes
+// of filling in which one millisecond of simulated time takes over 10 s) ends CANCELLED within the 5 s
+// the solver has to stop plus the worker's 1 s poll, by the solver's own stop: no SIGKILL escalation.
+TEST_F(EndToEnd, CancelDuringTheDemFillEndsCancelledWithinSecondsWithoutSigkill) {
+  auto server = start(1);
+  const nlohmann::json scene = {
+      {"name", "cancel-fill"},
+      {"apparatus", {{"type", "box"}, {"size", {0.1, 0.3, 0.05}}}},
+      {"grid", {{"cell_size", 0.01}}},
+      {"gas", nlohmann::json::object()},
+      {"particles", {{"diameter", 0.002}, {"density", 1040.0}}},
+      {"process", {{"bed_mass", 0.1}}},
+      {"dem", {{"time_step", 1e-6}, {"settle_time", 0.15}, {"ramp_time", 0.0}, {"warmup", 0.01},
+               {"sample_rate", 200}, {"probe_rate", 1000}, {"sample_duration", 0.05}, {"reference_duration", 0.03}}},
+      {"probes", {{{"name", "bed"}, {"position", {0.0025, 0.0025, 0.0075}}}}},
+      {"effects", {"rolling_friction"}}};
+  const std::string id = submit(*server, {{"kind", "database"}, {"scene", scene}, {"seed", 3}});
+  // In the fill: the solver reports DEM time while the fraction stays 0 (the fill is the only such phase).
+  const auto filling = pollJob(*server, id, [](const nlohmann::json& j) {
+    const auto& p = j.at("progress");
+    return j.at("state") == "RUNNING" && p.at("sim_time").is_number() && p.at("sim_time").get<double>() > 0.0 &&
+           p.at("fraction").get<double>() == 0.0;
+  });
+  ASSERT_EQ(filling.at("state"), "RUNNING") << filling.dump(2) << server->stderrText();
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(server->post("/v1/jobs/" + id + ":cancel", "").status, 202);
+  const auto done = pollJob(*server, id, isFinal);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  RecordProperty("seconds_to_cancelled", std::to_string(waited));
+  EXPECT_EQ(done.at("state"), "CANCELLED") << done.dump(2);
+  EXPECT_LT(waited, 5.0 + 1.0);
+  const auto events = server->get("/v1/jobs/" + id + "/events").json().at("events");
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.back().at("reason"), "the solver checkpointed and stopped") << events.dump(2);
+  for (const auto& e : events) EXPECT_EQ(e.dump().find("SIGKILL"), std::string::npos) << events.dump(2);
+  std::ifstream log(tmp_->path() / "data" / "jobs" / id / "solver.log");
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  EXPECT_NE(text.find("stopped while filling and settling the bed"), std::string::npos) << text;
+}
+
 // The cancel arrives as soon as the job is RUNNING, which is often before the solver child has
 // exec'd. It used to inherit the server's Asio SIGTERM handler there and shut the server down (the
 // "connection reset by peer" this test saw under load): the server must keep serving and the job end
