@@ -1,10 +1,13 @@
 #pragma once
 /// \file DatabasesApi.hpp
 /// POST /v1/databases: a field database uploaded by a client (e.g. from another CFD code), streamed
-/// to a temporary file by the HTTP session, validated with rcfd::FieldDatabase::open and only then
-/// kept under DIR/databases/<id>.h5. GET /v1/databases/{id} describes one.
+/// to a temporary file by the HTTP session, validated with rcfd::FieldDatabase::open in a child
+/// process (HDF5 can crash or loop on a damaged file: only the child goes, killed after
+/// --upload-check-timeout) and only then kept under DIR/databases/<id>.h5. GET /v1/databases/{id}
+/// describes one.
 
 #include <filesystem>
+#include <string_view>
 
 #include "HttpTypes.hpp"
 #include "JobStore.hpp"
@@ -13,14 +16,22 @@
 
 namespace rcfd::server {
 
+/// The first argument that makes rcfd-server the child validating an upload (main.cpp).
+inline constexpr std::string_view kCheckDatabaseArgument = "--check-uploaded-database";
+
+/// The validating child's work: opens `file` as a field database and reads every frame, then prints
+/// one JSON line, {"frames": N}, {"violations": [{"pointer", "message"}...]} or {"error": "..."}, to
+/// stdout; returns the exit code (0: a report was printed).
+int checkUploadedDatabase(const std::filesystem::path& file);
+
 class DatabasesApi {
  public:
   DatabasesApi(JobStore& store, const ServerConfig& config) : store_(store), config_(config) {}
 
   /// Where the session streams an upload before validation (unique per call).
   std::filesystem::path temporaryUploadPath() const;
-  /// Validates the uploaded file and registers it (201) or deletes it (422). Blocking: opens HDF5;
-  /// call it off the io_context threads.
+  /// Validates the uploaded file and registers it (201) or deletes it (422). Blocking: waits for the
+  /// validating child; call it off the io_context threads.
   StringResponse accept(const std::filesystem::path& file, const Target& target);
   Response get(const std::string& id, const Target& target);
 

@@ -15,6 +15,11 @@ namespace {
 constexpr std::uint32_t kHeaderLimit = 16 * 1024;     // bytes of a request header
 constexpr std::size_t kDrainLimit = 64u << 20;        // unread body bytes discarded before closing
 constexpr auto kDrainTimeout = std::chrono::seconds(5);
+
+/// The response with its header (Content-Length included) and no body: the answer to a HEAD.
+Response withoutBody(Response&& res) {
+  return std::visit([](auto& message) -> Response { return StringResponse(std::move(message.base())); }, res);
+}
 }  // namespace
 
 HttpSession::HttpSession(net::ip::tcp::socket&& socket, Router& router, net::thread_pool& blocking,
@@ -42,6 +47,7 @@ void HttpSession::doRead() {
   header_->body_limit(std::numeric_limits<std::uint64_t>::max());
   body_.reset();
   upload_.reset();
+  head_ = false;
   // A connection that never sent a token holds a descriptor for a few seconds only.
   const auto& config = router_.config();
   stream_.expires_after(tokenSeen_ ? config.readTimeout : std::min(config.readTimeout, config.idleBeforeToken));
@@ -58,6 +64,7 @@ void HttpSession::readError(beast::error_code ec) {
     return;
   }
   started_ = std::chrono::steady_clock::now();
+  head_ = failedReadIsHead();
   const std::string instance = instanceOfFailedRead();
   if (ec == http::error::body_limit) {
     send(problem(http::status::payload_too_large, "body-too-large", "Request body too large",
@@ -95,10 +102,19 @@ std::string HttpSession::instanceOfFailedRead() const {
   return instancePath(target);
 }
 
+bool HttpSession::failedReadIsHead() const {
+  if (body_ || upload_) return head_;
+  if (header_ && header_->get().method() == http::verb::head) return true;  // its request line was parsed
+  const auto unread = buffer_.data();
+  const std::string_view requestLine(static_cast<const char*>(unread.data()), unread.size());
+  return requestLine.rfind("HEAD ", 0) == 0;
+}
+
 void HttpSession::onHeader(beast::error_code ec, std::size_t) {
   if (ec) return readError(ec);
   started_ = std::chrono::steady_clock::now();
   const auto& req = header_->get();
+  head_ = req.method() == http::verb::head;
   tokenSeen_ = tokenSeen_ || req.find(http::field::authorization) != req.end();
   stream_.expires_after(router_.config().readTimeout);  // the body may take the full read time
   const std::string_view target(req.target().data(), req.target().size());
@@ -167,6 +183,7 @@ void HttpSession::onUpload(beast::error_code ec, std::size_t) {
 }
 
 void HttpSession::send(Response&& res, bool keepAlive) {
+  if (head_) res = withoutBody(std::move(res));
   std::visit(
       [&](auto& message) {
         using Message = std::decay_t<decltype(message)>;

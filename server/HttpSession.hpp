@@ -6,8 +6,10 @@
 /// their own limit); a request without the token is answered 401 from its header, before any limit
 /// or syntax of its body is judged; reads time out (expires_after). Responses are written one at a
 /// time, so the response queue of the Beast example has length one here: requests are read again
-/// only once the previous response is out. Uploads are validated on the blocking pool, never on an
-/// io thread.
+/// only once the previous response is out. The response to a HEAD request is its header only (RFC
+/// 9110 9.3.2), whatever the route answered, so the next response on the connection is not read
+/// from its body. Uploads are validated on the blocking pool (which waits for the validating child
+/// process, DatabasesApi), never on an io thread.
 
 #include <boost/asio/thread_pool.hpp>
 #include <boost/beast/core.hpp>
@@ -44,6 +46,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void readError(boost::beast::error_code ec);
   /// The problem `instance` of a request whose read failed: its path, as far as it was received.
   std::string instanceOfFailedRead() const;
+  /// Whether the request whose read failed is a HEAD: known once its request line was parsed, else
+  /// read from the request line still unread in the buffer.
+  bool failedReadIsHead() const;
 
   boost::beast::tcp_stream stream_;
   boost::beast::flat_buffer buffer_;
@@ -60,6 +65,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::array<char, 16384> scratch_{};
   std::shared_ptr<void> ticket_;
   bool tokenSeen_ = false;  ///< a request carried an Authorization header: the long idle time applies
+  bool head_ = false;       ///< the request answered is a HEAD: its response goes without a body
 };
 
 }  // namespace rcfd::server

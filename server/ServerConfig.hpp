@@ -23,6 +23,7 @@ struct ServerConfig {
   int maxConnections = 1024;                         ///< open connections in total (at most the descriptor limit less 64)
   int maxConnectionsPerPeer = 512;                   ///< open connections from one address (a proxy counts as one)
   std::chrono::seconds uploadTimeout{3600};          ///< whole-upload timeout
+  std::chrono::seconds uploadCheckTimeout{600};      ///< an upload's validation (a child process) is killed after this
   std::chrono::seconds shutdownGrace{120};           ///< wait for solvers to checkpoint on stop
   std::chrono::seconds cancelGrace{30};              ///< a cancelled solver still running after this is killed
   int autoRetries = 1;  ///< times a job whose solver was killed from outside (SIGKILL: out of memory) is requeued

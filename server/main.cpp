@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <string_view>
 #include <thread>
 
 #include "Ids.hpp"
@@ -109,6 +110,9 @@ std::filesystem::path defaultSolver() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // The child that validates an upload (DatabasesApi::accept): HDF5 may crash or loop on a damaged
+  // file, so the server never opens an uploaded file itself.
+  if (argc == 3 && std::string_view(argv[1]) == kCheckDatabaseArgument) return checkUploadedDatabase(argv[2]);
   CLI::App app{"rcfd-server: the rcfd job server (REST under /v1, docs/api.md)"};
   ServerConfig config;
   std::string dataDir, listen = "127.0.0.1:8080", tokenFile, solver;
@@ -146,6 +150,10 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(1, 1000000));
   app.add_option("--max-connections-per-peer", config.maxConnectionsPerPeer, "open connections from one address")
       ->capture_default_str()->check(CLI::Range(1, 1000000));
+  int uploadCheckTimeout = static_cast<int>(config.uploadCheckTimeout.count());
+  app.add_option("--upload-check-timeout", uploadCheckTimeout,
+                 "seconds the validation of an uploaded database may take before it is stopped (422)")
+      ->capture_default_str()->check(CLI::Range(1, 86400));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -165,6 +173,7 @@ int main(int argc, char** argv) {
     config.shutdownGrace = std::chrono::seconds(graceSeconds);
     config.idleBeforeToken = std::chrono::seconds(idleBeforeToken);
     config.cancelGrace = std::chrono::seconds(cancelGrace);
+    config.uploadCheckTimeout = std::chrono::seconds(uploadCheckTimeout);
     // Connections beyond the descriptor limit would make accept fail: keep 64 for SQLite, logs, solvers.
     if (rlimit files{}; maxConnections->count() == 0 && ::getrlimit(RLIMIT_NOFILE, &files) == 0 &&
                         files.rlim_cur != RLIM_INFINITY)
