@@ -361,9 +361,14 @@ void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::stri
       return;
     }
     if (code == exit_code::cancelled) {
-      if (cancelling)
-        store_.transition(job.id, from, state::cancelled, "the solver checkpointed and stopped");
-      else if (stopping)
+      if (cancelling) {
+        // A cancel in the DEM fill stops before there is any state worth a checkpoint.
+        std::error_code ec;
+        const bool checkpoint = std::filesystem::exists(config_.jobDir(job.id) / "checkpoint.h5", ec);
+        store_.transition(job.id, from, state::cancelled,
+                          checkpoint ? "the solver checkpointed and stopped"
+                                     : "the solver stopped before its first checkpoint; a retry starts from the beginning");
+      } else if (stopping)
         store_.transition(job.id, from, state::queued,
                           "server shut down; the job resumes from its checkpoint");
       else

@@ -450,7 +450,9 @@ TEST_F(EndToEnd, CancelDuringTheDemFillEndsCancelledWithinSecondsWithoutSigkill)
   EXPECT_LT(waited, 5.0 + 1.0);
   const auto events = server->get("/v1/jobs/" + id + "/events").json().at("events");
   ASSERT_FALSE(events.empty());
-  EXPECT_EQ(events.back().at("reason"), "the solver checkpointed and stopped") << events.dump(2);
+  EXPECT_EQ(events.back().at("reason"),
+            "the solver stopped before its first checkpoint; a retry starts from the beginning")
+      << events.dump(2);
   for (const auto& e : events) EXPECT_EQ(e.dump().find("SIGKILL"), std::string::npos) << events.dump(2);
   std::ifstream log(tmp_->path() / "data" / "jobs" / id / "solver.log");
   const std::string text((std::istreambuf_iterator<char>(log)), {});
