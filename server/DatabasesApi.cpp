@@ -12,6 +12,7 @@
 #include <iostream>
 #include <thread>
 
+#include "ChildSignals.hpp"
 #include "Ids.hpp"
 #include "Problem.hpp"
 #include "fields/FieldDatabase.hpp"
@@ -39,22 +40,11 @@ CheckOutcome checkInChild(const std::filesystem::path& file, std::chrono::second
   const std::string self = "/proc/self/exe", flag(kCheckDatabaseArgument), path = file.string();
   std::vector<const char*> argv = {self.c_str(), flag.c_str(), path.c_str(), nullptr};
   const pid_t parent = ::getpid();
-  // As for the solvers (WorkerPool::runJob): fork with every signal blocked, so that none reaches the
-  // server's handlers in the child, which restores the default dispositions before it unblocks them.
-  sigset_t all, previous;
-  ::sigfillset(&all);
-  ::pthread_sigmask(SIG_BLOCK, &all, &previous);
+  const sigset_t previous = blockAllSignals();  // ChildSignals.hpp
   const pid_t pid = ::fork();
   if (pid == 0) {
     // Child: only async-signal-safe calls until exec.
-    struct sigaction byDefault {};
-    byDefault.sa_handler = SIG_DFL;
-    ::sigemptyset(&byDefault.sa_mask);
-    for (int sig = 1; sig < NSIG; ++sig)
-      if (sig != SIGKILL && sig != SIGSTOP) ::sigaction(sig, &byDefault, nullptr);
-    sigset_t none;
-    ::sigemptyset(&none);
-    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    defaultSignalsInChild(false);
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // the server gone: nobody waits for the answer
     if (::getppid() != parent) ::_exit(127);
     const int devnull = ::open("/dev/null", O_RDWR);

@@ -1,7 +1,7 @@
 #pragma once
 /// \file DatabasesApi.hpp
 /// POST /v1/databases: a field database uploaded by a client (e.g. from another CFD code), streamed
-/// to a temporary file by the HTTP session, validated with rcfd::FieldDatabase::open in a child
+/// to a temporary file by HttpSession, validated with rcfd::FieldDatabase::open in a child
 /// process (HDF5 can crash or loop on a damaged file: only the child goes, killed after
 /// --upload-check-timeout) and only then kept under DIR/databases/<id>.h5. GET /v1/databases/{id}
 /// describes one.

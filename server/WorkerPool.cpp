@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "ChildSignals.hpp"
 #include "DatabaseRef.hpp"
 #include "core/Errors.hpp"
 
@@ -214,27 +215,14 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
     // Solvers are batch work: nicer than the server, whose I/O threads answer polls in microseconds
     // and would otherwise queue behind a solver's threads for a scheduler slice.
     const int solverNice = std::min(19, ::getpriority(PRIO_PROCESS, 0) + config_.workerNice);
-    // The child starts as a copy of the server, signal handlers included: Asio's SIGTERM handler
-    // writes into the server's signal pipe, so a cancel (SIGTERM) reaching the child before exec
-    // would shut the *server* down. So fork with every signal blocked, and let the child restore
-    // default dispositions before it unblocks them (what posix_spawn's SETSIGDEF does).
-    sigset_t all, previous;
-    ::sigfillset(&all);
-    ::pthread_sigmask(SIG_BLOCK, &all, &previous);
+    // A cancel (SIGTERM) must not reach the server's handlers in the child (ChildSignals.hpp).
+    const sigset_t previous = blockAllSignals();
     pid = ::fork();
     if (pid == 0) {
-      // Child: only async-signal-safe calls until exec.
-      struct sigaction byDefault {};
-      byDefault.sa_handler = SIG_DFL;
-      ::sigemptyset(&byDefault.sa_mask);
-      for (int sig = 1; sig < NSIG; ++sig)
-        if (sig != SIGKILL && sig != SIGSTOP) ::sigaction(sig, &byDefault, nullptr);
-      // SIGPIPE stays ignored, as in the server: a solver whose server died must get EPIPE on its
-      // progress pipe and go on to checkpoint on the PDEATHSIG SIGTERM, not die of SIGPIPE first.
-      ::signal(SIGPIPE, SIG_IGN);
-      sigset_t none;
-      ::sigemptyset(&none);
-      ::sigprocmask(SIG_SETMASK, &none, nullptr);  // a pending SIGTERM now ends the child: cancelled
+      // Child: only async-signal-safe calls until exec. SIGPIPE stays ignored, as in the server: a
+      // solver whose server died must get EPIPE on its progress pipe and go on to checkpoint on the
+      // PDEATHSIG SIGTERM, not die of SIGPIPE first. A pending SIGTERM then ends the child: cancelled.
+      defaultSignalsInChild(true);
       ::setpgid(0, 0);                      // a terminal's Ctrl-C reaches the server only
       ::setpriority(PRIO_PROCESS, 0, solverNice);  // the solver's threads inherit it
       ::prctl(PR_SET_PDEATHSIG, SIGTERM);   // server gone -> checkpoint and exit 130

@@ -58,6 +58,19 @@ struct Reply {
   }
 };
 
+/// A response as a Reply: status, lower-case header names, body.
+inline Reply replyOf(const boost::beast::http::response<boost::beast::http::string_body>& response) {
+  Reply r;
+  r.status = response.result_int();
+  for (const auto& f : response) {
+    std::string name(f.name_string());
+    for (auto& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    r.headers[name] = std::string(f.value());
+  }
+  r.body = response.body();
+  return r;
+}
+
 /// One HTTP exchange on a new connection.
 inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, const std::string& target,
                          const std::string& token = {}, const std::string& body = {},
@@ -82,15 +95,7 @@ inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, c
   parser.body_limit(1ull << 30);
   http::read(stream, buffer, parser, readEc);
   if (readEc) throw std::runtime_error("http read failed: " + readEc.message());
-  Reply r;
-  r.status = parser.get().result_int();
-  for (const auto& f : parser.get()) {
-    std::string name(f.name_string());
-    for (auto& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    r.headers[name] = std::string(f.value());
-  }
-  r.body = parser.get().body();
-  return r;
+  return replyOf(parser.get());
 }
 
 /// A running rcfd-server child process.

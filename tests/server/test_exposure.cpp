@@ -31,15 +31,7 @@ Reply rawExchange(unsigned short port, const std::string& bytes) {
   http::response_parser<http::string_body> parser;
   http::read(stream, buffer, parser, readEc);
   if (readEc) throw std::runtime_error("http read failed: " + readEc.message());
-  Reply r;
-  r.status = parser.get().result_int();
-  for (const auto& f : parser.get()) {
-    std::string name(f.name_string());
-    for (auto& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    r.headers[name] = std::string(f.value());
-  }
-  r.body = parser.get().body();
-  return r;
+  return replyOf(parser.get());
 }
 
 /// The problem+json body of `r`, after checking that it is one with `status`.

@@ -458,7 +458,8 @@ class RequestGenerator {
     }
   }
 
-  /// A placeholder string, replaced by `token` verbatim once the document is dumped.
+  /// A marker string that stands for `token` in the document; dumping replaces it by the token's
+  /// bytes verbatim (JSON could not hold them as they are).
   nlohmann::json raw(const std::string& token) {
     raws_.push_back(token);
     return "@@raw" + std::to_string(raws_.size() - 1) + "@@";
