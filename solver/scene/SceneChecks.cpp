@@ -1,5 +1,6 @@
 #include "scene/SceneChecks.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -7,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "cfddem/DemMaterial.hpp"
 #include "scene/DatabaseSchedule.hpp"
 #include "scene/SchemaExplainer.hpp"
 
@@ -139,6 +141,18 @@ std::vector<Violation> checkDatabaseScene(const Scene& s) {
                                             num(chamber) + " m3: at most " +
                                             num(chamber * kDensestRandomPacking * s.particles.density) + " kg fits"});
   }
+  // The gas enters through the prism's inlet slot; a box has walls all round (GasSolver refuses it).
+  if (s.apparatus.type == ApparatusSpec::Type::Box && s.hasEffect("gas")) {
+    const auto at = std::find(s.effects.begin(), s.effects.end(), "gas") - s.effects.begin();
+    out.push_back({"/effects/" + std::to_string(at), "the gas needs an inlet: a box's bottom is a wall, the effect gas "
+                                                     "needs the inlet slot of a prismatic_spouted_bed"});
+  }
+  // The DEM time step against the Rayleigh time of the parcels (the job would refuse it at start).
+  try {
+    checkTimeStep(DemMaterial::fromScene(s), s.dem.time_step, s.dem.max_rayleigh_fraction);
+  } catch (const InputError& e) {
+    for (const auto& v : e.violations()) out.push_back(v);
+  }
   for (auto& v : DatabaseSchedule::violations(s)) out.push_back(std::move(v));
   return out;
 }
@@ -204,6 +218,26 @@ std::vector<Violation> checkSceneSemantics(const Scene& s, const json& document)
     }
     if (zone.y_max > upper.y()) {
       out.push_back({"/spray/spray_zone/y_max", num(zone.y_max) + " is above the apparatus top y = " + num(upper.y())});
+    }
+  }
+  if (s.hasEffect("spray")) {
+    const auto& sp = s.spray;
+    // Eq. (15): a droplet covers f = (d_D / 2 d_P)^2 of its particle; the deposition on particles as
+    // spots needs droplets smaller than the particles (f < 1/4).
+    if (!(sp.droplet_diameter < s.particles.diameter)) {
+      out.push_back({"/spray/droplet_diameter", num(sp.droplet_diameter) +
+                                                    " m is not smaller than the particle diameter /particles/diameter = " +
+                                                    num(s.particles.diameter) + " m (Eq. 15 covers particles with droplet spots)"});
+    }
+    // A parcel carries at least one droplet (N_D,min = 1): with fewer, every parcel would be dropped
+    // as residual at once and nothing deposit.
+    const double dropletMass = sp.droplet_density * std::numbers::pi / 6.0 * std::pow(sp.droplet_diameter, 3);
+    const double dropletRate = sp.mass_rate / dropletMass;
+    if (sp.parcels_per_s > dropletRate) {
+      out.push_back({"/spray/parcels_per_s", num(sp.parcels_per_s) + " parcels/s would carry " +
+                                                 num(dropletRate / sp.parcels_per_s) +
+                                                 " droplets each; every parcel needs at least one: at most " +
+                                                 num(dropletRate) + " parcels/s (mass_rate / droplet mass)"});
     }
   }
 
