@@ -93,7 +93,14 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
     const int gasSteps = std::max(1, int(std::ceil(dt / stable * (1.0 - 1e-12))));
     for (int s = 0; s < gasSteps; ++s) {
       const double h = dt / gasSteps;
-      const double taken = gas_->step(h);
+      double taken = 0.0;
+      try {
+        taken = gas_->step(h);
+      } catch (const RunError& e) {  // the gas's own message (e.g. the residual), with when it happened
+        std::ostringstream m;
+        m << "CFD-DEM at t = " << time() << " s (DEM step " << demStep_ << ", gas step of " << h << " s): " << e.what();
+        throw RunError(m.str());
+      }
       if (taken < h * (1.0 - 1e-12)) {
         std::ostringstream m;
         m << "CFD-DEM: the gas step was limited to " << taken << " s below the planned " << h << " s at t = "

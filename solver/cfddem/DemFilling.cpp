@@ -25,9 +25,14 @@ FillRegion defaultFillRegion(const ApparatusSpec& a) {
   if (a.type == ApparatusSpec::Type::Box) {
     r.lower = Vector3d(-0.5 * a.size.x(), 2.0 / 3.0 * a.size.y(), 0.0);
     r.upper = Vector3d(0.5 * a.size.x(), a.size.y(), a.size.z());
-  } else {
+  } else if (a.height >= 0.3) {
     r.lower = Vector3d(-0.5 * a.width, 0.2, 0.0);
-    r.upper = Vector3d(0.5 * a.width, std::min(0.3, a.height), a.depth);
+    r.upper = Vector3d(0.5 * a.width, 0.3, a.depth);
+  } else {
+    // A chamber lower than the paper's region: its upper third, and above the top of the V-bottom.
+    const double vTop = 0.5 * (a.width - a.inlet_width) * std::tan(a.prism_angle_deg * std::numbers::pi / 180.0);
+    r.lower = Vector3d(-0.5 * a.width, std::max(2.0 / 3.0 * a.height, vTop), 0.0);
+    r.upper = Vector3d(0.5 * a.width, a.height, a.depth);
   }
   return r;
 }

@@ -54,7 +54,8 @@ struct FillResult {
 long parcelsForBedMass(const Scene& scene);
 
 /// The paper's insertion region for the prismatic spouted bed, 0.2 m < y < 0.3 m over the chamber's
-/// width and depth; for a box, the upper third.
+/// width and depth (a chamber lower than 0.3 m: its upper third, above the V-bottom's top); for a box,
+/// the upper third.
 FillRegion defaultFillRegion(const ApparatusSpec& apparatus);
 
 /// Inserts `count` parcels in `region` (clear of walls and of each other), lets them fall and settles.

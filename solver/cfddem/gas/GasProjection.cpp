@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <cstdio>
 #include <cstdlib>
 
@@ -84,10 +85,14 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
   for (int attempt = 0; attempt < 4; ++attempt) {
     const auto stats = pressureSolver_->solve(b, q_, absTol, options_.maxPressureIterations);
     last_.pressureIterations += stats.iterations;
-    if (!stats.converged)
-      throw RunError("gas solver: the pressure solver did not converge in " + std::to_string(stats.iterations) +
-                     " iterations (residual " + std::to_string(stats.residual / std::max(scale.norm(), 1e-300)) +
-                     " of the flux scale, tolerance /gas/pressure_tolerance = " + std::to_string(tol) + ")");
+    if (!stats.converged) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "gas solver: the pressure solver did not converge in " << stats.iterations << " iterations (relative residual "
+        << stats.residual / std::max(scale.norm(), 1e-300) << ", goal " << absTol / std::max(scale.norm(), 1e-300)
+        << " from the tolerance /gas/pressure_tolerance = " << tol << ")";
+      throw RunError(m.str());
+    }
     u_ = predicted;
     correct(diag);
     last_.divergence = divergence();
