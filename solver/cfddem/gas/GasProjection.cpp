@@ -90,7 +90,9 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
       m.precision(3);
       m << "gas solver: the pressure solver did not converge in " << stats.iterations << " iterations (relative residual "
         << stats.residual / std::max(scale.norm(), 1e-300) << ", goal " << absTol / std::max(scale.norm(), 1e-300)
-        << " from the tolerance /gas/pressure_tolerance = " << tol << ")";
+        << " from the tolerance /gas/pressure_tolerance = " << tol
+        << "; a tolerance near the solver's round-off floor, which cells of a large aspect ratio raise, needs "
+           "loosening)";
       throw RunError(m.str());
     }
     u_ = predicted;
@@ -230,9 +232,13 @@ DivergenceResidual GasSolver::divergence() const {
     ss += scale[c] * scale[c];
     out.maxAbs = std::max(out.maxAbs, std::abs(r[c]) / vol);
   }
-  out.relative = ss > 0 ? std::sqrt(rr / ss) : 0.0;
+  // Both measures are relative to the step's own fluxes, but never to less than a millionth of the
+  // scene's full gas flow: a gas at rest (no flow yet at the start of the ramp, no drag to stir it) has
+  // only round-off fluxes, whose residuals are as large as themselves.
+  const double least = 1e-6 * (scene_.process.gas_flow_rate + scene_.process.atomisation_flow_rate);
+  out.relative = ss > 0 ? std::sqrt(rr / std::max(ss, least * least)) : 0.0;
   // Relative to the gas fed; without a feed (gas moved only by alpha_G), to what is stored.
-  const double netScale = supply > 0 ? supply : stored;
+  const double netScale = std::max(supply > 0 ? supply : stored, least);
   out.net = netScale > 0 ? std::abs(sum) / netScale : 0.0;
   return out;
 }
