@@ -139,7 +139,7 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
     for (long attempts = 1; result.inserted < count && misses < max_misses; ++attempts) {
       if (attempts % kInsertionAttemptsPerPoll == 0) throwIfStopRequested(dem, o.stop_requested);
       const Vector3d x = lo + (hi - lo).cwiseProduct(Vector3d(u(rng), u(rng), u(rng)));
-      if (dem.walls().clearance(x) < 1.01 * r || !occ.free(x, gap)) {
+      if (dem.walls().clearance(x) < 1.01 * r || (o.inside && !o.inside(x)) || !occ.free(x, gap)) {
         ++misses;
         continue;
       }

@@ -39,6 +39,10 @@ struct FillOptions {
   std::function<bool()> stop_requested;
   /// Called as the filling enters each stage (the job's progress names it). Empty: not called.
   std::function<void(FillStage)> stage_started;
+  /// A new parcel's centre must also lie inside the open region by this test (the apparatus's signed
+  /// distance > 0): the walls' clearance is a distance, the same in front of a wall and behind it, and
+  /// a region that reaches behind a steep V-bottom would otherwise take parcels there. Empty: any.
+  std::function<bool(const Eigen::Vector3d&)> inside;
 };
 
 struct FillResult {

@@ -124,8 +124,9 @@ class JobGenerator {
       cells_[std::size_t(d)] = extent_[std::size_t(d)] / (double(n) + uniform(-0.2, 0.3) + (n == 1 ? 0.3 : 0.0));
     }
     minCell_ = std::min({cells_[0], cells_[1], cells_[2]});
-    if (chance(0.3)) {  // one number for all three; 10 % of those as large as the largest (may be refused)
-      const double c = chance(0.1) ? std::max({cells_[0], cells_[1], cells_[2]}) : minCell_;
+    if (chance(0.3)) {  // one number for all three (about 1,500 cells); 10 % as large as the largest (may be refused)
+      const double c = chance(0.1) ? std::max({cells_[0], cells_[1], cells_[2]})
+                                   : std::max(minCell_, std::cbrt(extent_[0] * extent_[1] * extent_[2] / 1500.0));
       cells_ = {c, c, c};
       minCell_ = c;
       return {{"cell_size", c}};
