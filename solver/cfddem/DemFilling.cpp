@@ -124,8 +124,9 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
   while (result.inserted < count) {
     if (result.batches >= o.max_batches)
       throw RunError("DEM filling: " + std::to_string(count - result.inserted) + " of " +
-                     std::to_string(count) + " parcels found no room after " +
-                     std::to_string(o.max_batches) + " batches; enlarge the insertion region");
+                     std::to_string(count) + " parcels found no room after " + std::to_string(o.max_batches) +
+                     " batches: the bed does not pour into the chamber below the filling region (a smaller "
+                     "/process/bed_mass fits; docs/dem.md)");
     ++result.batches;
     Occupancy occ{2.0 * r, {}};
     const DemParticles& p = dem.particles();

@@ -88,14 +88,15 @@ inline std::string below(const std::string& base, const std::string& k) { return
 
 /// Every null in a summary that stands for a number is a NaN or infinity the JSON writer could not
 /// print, except the keys documented as null when there is nothing to compute (no reference, no stay,
-/// no dominant frequency, no sampling bound of a constant probe signal: docs/calibration.md,
-/// docs/database.md).
+/// no dominant frequency, no sampling bound of a constant probe signal, a pressure-drop series too
+/// short for its statistics: docs/calibration.md, docs/database.md).
 inline void findNulls(const json& v, const std::string& at, std::vector<std::string>& out) {
   static const std::set<std::string> nullable = {
       "stay_comparison", "coverage_comparison", "reference_coverage", "dominant_frequency_hz", "penalty_minimum_d0",
       "binding_d0", "selected_d0", "error", "crossings_per_member_per_s", "crossing_rate_relative_error",
       "mean_relative_error", "longest_compared_s", "rtd_ks_distance", "holdup_relative_error",
-      "residence_time_mean_relative_error", "bound_s", "largest_admissible_dt_rec_s", "satisfied"};
+      "residence_time_mean_relative_error", "bound_s", "largest_admissible_dt_rec_s", "satisfied",
+      "mean_pa", "std_pa", "frequency_resolution_hz"};  // (a pressure-drop series of fewer than 4 samples)
   if (v.is_null()) {
     const std::string key = at.substr(at.rfind('/') + 1);
     if (!nullable.count(key)) out.push_back("summary.json" + at + " is null (a NaN or infinity?)");

@@ -242,3 +242,33 @@ TEST(CfdDemCases, TheGasInABoxIsRefusedWhenTheJobIsLoaded) {
   EXPECT_NE(o.stderrText.find("/scene/effects/0"), std::string::npos) << o.stderrText;
   EXPECT_NE(o.stderrText.find("prismatic_spouted_bed"), std::string::npos) << o.stderrText;
 }
+
+// At the start of the ramp nothing is fed while the drag of moving parcels stirs the gas: the domain's
+// mass balance is measured against the cells' fluxes, not against a feed of 0.
+TEST(CfdDemCases, AGasStirredByParcelsBeforeAnyFeedPassesItsMassBalance) {
+  expectDatabaseJobRuns("gas-stirred-without-feed.json");
+}
+
+namespace {
+
+/// A database job on a scene file that must be refused at once, naming `pointer`.
+void expectDatabaseJobRefused(const std::string& file, const std::string& pointer) {
+  const fs::path dir = caseDirectory(file);
+  const Outcome o = runJob(databaseJob(sceneFile(file)), dir, 30.0);
+  EXPECT_EQ(inputErrorProblem(o), "");
+  EXPECT_NE(o.stderrText.find(pointer), std::string::npos) << o.stderrText;
+  EXPECT_LT(o.seconds, 10.0);
+}
+
+}  // namespace
+
+// A bed that fits the chamber packed but cannot be poured into it from the filling region (48 % of a
+// chamber 2.7 parcels deep) is refused when the job is loaded, not after 200 batches of filling.
+TEST(CfdDemCases, ABedThatDoesNotPourIntoTheChamberIsRefusedBeforeTheFill) {
+  expectDatabaseJobRefused("bed-does-not-pour.json", "/scene/process/bed_mass");
+}
+
+// Parcels larger than the region the bed is poured from are refused when the job is loaded.
+TEST(CfdDemCases, ParcelsLargerThanTheFillingRegionAreRefusedBeforeTheFill) {
+  expectDatabaseJobRefused("parcel-larger-than-fill-region.json", "/scene/particles/diameter");
+}

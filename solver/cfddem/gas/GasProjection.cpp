@@ -225,8 +225,10 @@ DivergenceResidual GasSolver::divergence() const {
   for (const auto& [d, f] : inletFaces_) supply += std::abs(gasArea_[std::size_t(d)][f] * u_[std::size_t(d)][f]);
   DivergenceResidual out;
   double rr = 0.0, ss = 0.0, sum = 0.0;
+  std::size_t cells = 0;
   for (std::size_t c = 0; c < r.size(); ++c) {
     if (!active_[c]) continue;
+    ++cells;
     sum += r[c];
     rr += r[c] * r[c];
     ss += scale[c] * scale[c];
@@ -237,8 +239,11 @@ DivergenceResidual GasSolver::divergence() const {
   // only round-off fluxes, whose residuals are as large as themselves.
   const double least = 1e-6 * (scene_.process.gas_flow_rate + scene_.process.atomisation_flow_rate);
   out.relative = ss > 0 ? std::sqrt(rr / std::max(ss, least * least)) : 0.0;
-  // Relative to the gas fed; without a feed (gas moved only by alpha_G), to what is stored.
-  const double netScale = std::max(supply > 0 ? supply : stored, least);
+  // Relative to the gas fed; without a feed (gas moved only by alpha_G), to what is stored; and never to
+  // less than the cells' root-mean-square flux: at the start of a ramp nothing is fed yet while the
+  // drag of moving parcels stirs the gas, and a balance relative to a feed of 0 cannot be met.
+  const double rmsCell = cells > 0 ? std::sqrt(ss / double(cells)) : 0.0;
+  const double netScale = std::max({supply > 0 ? supply : stored, least, rmsCell});
   out.net = netScale > 0 ? std::abs(sum) / netScale : 0.0;
   return out;
 }
