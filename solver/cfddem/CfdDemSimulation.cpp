@@ -143,13 +143,29 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
 
 void CfdDemSimulation::checkParcels() const {
   const DemParticles& p = dem_->particles();
-  for (std::size_t i = 0; i < p.size(); ++i)
+  const Eigen::Vector3d lower = apparatus_->lowerCorner(), upper = apparatus_->upperCorner();
+  for (std::size_t i = 0; i < p.size(); ++i) {
     if (!p.x[i].allFinite() || !p.v[i].allFinite()) {
       std::ostringstream m;
       m << "CFD-DEM: parcel " << p.id[i] << " has a non-finite position or velocity at t = " << time()
         << " s (DEM step " << demStep_ << "), at x = (" << p.x[i].transpose() << ")";
       throw RunError(m.str());
     }
+    // A parcel whose centre left the chamber's bounding box passed a wall within one DEM step: it moved
+    // so far per step that its wall contact was never resolved. The scene's DEM step is too long for the
+    // speeds the gas gives the parcels (the Rayleigh criterion bounds the contact stiffness, not the
+    // speed).
+    if (((p.x[i] - lower).array() < 0.0).any() || ((upper - p.x[i]).array() < 0.0).any()) {
+      const double dt = dem_->timeStep(), speed = p.v[i].norm(), r = p.radius[i];
+      std::ostringstream m;
+      m.precision(3);
+      m << "parcel " << p.id[i] << " left the chamber at t = " << time() << " s (DEM step " << demStep_
+        << ") moving at " << speed << " m/s: " << dt << " s moves it " << speed * dt / r
+        << " radii a step, too far for its wall contacts; at most " << (speed > 0.0 ? 0.5 * r / speed : dt)
+        << " s (half a radius a step at that speed) keeps them resolved";
+      throw InputError("scene", "/dem/time_step", m.str());
+    }
+  }
 }
 
 std::int64_t CfdDemSimulation::demStep() const { return demStep_; }

@@ -272,3 +272,15 @@ TEST(CfdDemCases, ABedThatDoesNotPourIntoTheChamberIsRefusedBeforeTheFill) {
 TEST(CfdDemCases, ParcelsLargerThanTheFillingRegionAreRefusedBeforeTheFill) {
   expectDatabaseJobRefused("parcel-larger-than-fill-region.json", "/scene/particles/diameter");
 }
+
+// Soft parcels (a long Rayleigh time, so a long DEM step) blown by an 83 m/s inlet move more than a
+// radius a step and pass a wall: the first parcel outside the chamber stops the job naming
+// /dem/time_step, its speed and the step that keeps its wall contacts resolved.
+TEST(CfdDemCases, ADemStepTooLongForTheParcelsSpeedsIsRefusedNamingTheLongestThatFits) {
+  const fs::path dir = caseDirectory("dem-step-too-long");
+  const Outcome o = runJob(databaseJob(sceneFile("dem-step-too-long.json")), dir, 60.0);
+  EXPECT_EQ(inputErrorProblem(o), "");
+  for (const char* part : {"/dem/time_step", "left the chamber", "radii a step", "keeps them resolved"}) {
+    EXPECT_NE(o.stderrText.find(part), std::string::npos) << part << " in\n" << o.stderrText;
+  }
+}
