@@ -344,7 +344,7 @@ Response JobsApi::list(const Target& target, const Caller& caller) {
   for (const auto& job : rows) body["jobs"].push_back(toJson(job));
   if (more) {
     nlohmann::json token = {{"after", rows.back().seq}, {"state", filter.state}, {"kind", filter.kind}};
-    // Only when set: the tokens of an admin's whole listing stay what they were before there were users.
+    // Only when set: an admin's unfiltered listing has tokens without an owner, as a single-token server's.
     if (!filter.owner.empty()) token["owner"] = filter.owner;
     body["next_page_token"] = signPageToken(token, config_.pageTokenKey);
   }
