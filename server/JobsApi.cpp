@@ -462,9 +462,13 @@ Response JobsApi::coverage(const std::string& id, const Target& target, const Ca
                           target);
     bins = mergeBins(stored, n);
   }
-  if (format == "json") return jsonResponse(http::status::ok, coverageJson(id, bins));
+  // An ensemble's band over its members, from the member counts in its summary.
+  std::optional<CoverageBand> band;
+  if (const auto summary = store_.summary(id)) band = coverageBand(*summary, bins.size());
+  const CoverageBand* withBand = band ? &*band : nullptr;
+  if (format == "json") return jsonResponse(http::status::ok, coverageJson(id, bins, withBand));
   if (format == "csv") {
-    auto res = textResponse(http::status::ok, coverageCsv(bins), "text/csv; charset=utf-8");
+    auto res = textResponse(http::status::ok, coverageCsv(bins, withBand), "text/csv; charset=utf-8");
     res.set(http::field::content_disposition, "attachment; filename=\"coverage.csv\"");
     return res;
   }
@@ -480,7 +484,7 @@ Response JobsApi::coverage(const std::string& id, const Target& target, const Ca
   }
   const auto path = config_.jobDir(id) / exportName;
   std::string error;
-  if (!writeCoverageH5(path, id, bins, error))
+  if (!writeCoverageH5(path, id, bins, error, withBand))
     return problem(http::status::internal_server_error, "export-failed", "Export failed", error,
                    target.path);
   const int fd = openJobFile(config_, id, exportName);
