@@ -1,7 +1,7 @@
 #pragma once
-// A circulating spouted bed for the tracer and spray benchmarks (since 2026-12-03; before, the swaying
-// spout of SyntheticFields.hpp, whose u_P converges onto a few surfaces: after 2 s of process its
-// 472,850 tracers sat in about 1,100 cells, up to 5,600 per cell, alpha_P of the tracers above 40).
+// A circulating spouted bed for the tracer and spray benchmarks. Not the swaying spout of
+// SyntheticFields.hpp, whose u_P converges onto a few surfaces: after 2 s of process its 472,850
+// tracers sit in about 1,100 cells, up to 5,600 per cell, alpha_P of the tracers above 40.
 //
 // Here the particle flux alpha_P u_P^rec is the curl of a stream function psi(x, y), so it is
 // divergence-free and alpha_P^rec is the tracers' stationary density: in a steady field, tracers placed

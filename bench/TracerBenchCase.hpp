@@ -2,8 +2,8 @@
 // The paper-scale tracer case shared by `rcfd-bench tracers` and `rcfd-bench spray`: the ProCell
 // apparatus (250 x 600 x 200 mm) on 7.4 mm cells (34 x 81 x 27 = 74,358 cells, the paper's 73,647
 // within 1%), 472,850 tracers, 100 in-memory frames of a circulating spouted bed (CirculatingBed.hpp;
-// until 2026-12-03 the swaying spout of SyntheticFields.hpp, still selected by
-// RCFD_BENCH_FIELD=swaying_spout for comparisons with older figures), dt = dt_rec = 5 ms.
+// RCFD_BENCH_FIELD=swaying_spout selects the swaying spout of SyntheticFields.hpp, a field that
+// gathers the tracers into a few cells), dt = dt_rec = 5 ms.
 // --quick: 15 mm cells, 47,285 tracers, 10 frames.
 #include <algorithm>
 #include <chrono>
@@ -35,7 +35,7 @@ inline double processCpuSeconds() {
 /// What makes a field database costly to move tracers through, weighted by solids volume (alpha_P x
 /// open volume) over all frames: the fraction of the solids moving more than one cell per step (they
 /// need sub-steps), faster than 1 m/s, their mean speed, and the fractions in dense (alpha_P > 0.45)
-/// and dilute (alpha_P < 0.2) cells. For comparison, the quick example's CFD-DEM database (2026-12-03):
+/// and dilute (alpha_P < 0.2) cells. For comparison, the quick example's CFD-DEM database:
 /// 0.074, 0.187, 0.58 m/s, 0.33 and 0.40; the circulating bed 0.075, 0.135, 0.57, 0.29 and 0.38.
 inline nlohmann::json fieldStatistics(const FieldDatabase& db, double dt) {
   const CartesianGrid& g = db.grid();

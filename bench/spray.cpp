@@ -6,7 +6,7 @@
 // projected wall time of 1 h of process, and the spray stage's cost relative to the tracer step.
 // RCFD_BENCH_INTEGRATOR=euler|midpoint overrides the scene's integrator (an accuracy knob, as in
 // `rcfd-bench tracers`); RCFD_BENCH_TRACERS the tracer count, RCFD_BENCH_STEPS the timed steps,
-// RCFD_BENCH_FIELD=swaying_spout the field before 2026-12-03 (TracerBenchCase.hpp).
+// RCFD_BENCH_FIELD=swaying_spout the swaying spout (TracerBenchCase.hpp).
 // RCFD_BENCH_SPRAY_ONLY=1 times the spray configuration alone (no tracer-only twin, no overhead
 // figures), with progress on stderr every 1% of the steps: for long runs that measure the goal
 // directly, e.g. RCFD_BENCH_STEPS=720000 is 1 h of process, which averages over the VM's phases.
@@ -32,18 +32,18 @@ nlohmann::json runSpray(const Options& options) {
   // 400 untimed steps (2 s of process) first. In the circulating bed the airborne parcels settle at
   // 600-1,000 within 0.1 s (most deposit in the spout within 10 ms), and the tracers leave the initial
   // placement's exact alpha_P^rec for the distribution the flow keeps. (In the swaying spout,
-  // RCFD_BENCH_FIELD=swaying_spout, the parcels reach about 19,550 only after some 400 steps; until
-  // 2026-12-03 the warm-up was 60 steps.) RCFD_BENCH_SPRAY_ONLY=1 and a long RCFD_BENCH_STEPS show it.
+  // RCFD_BENCH_FIELD=swaying_spout, the parcels reach about 19,550 only after some 400 steps.)
+  // RCFD_BENCH_SPRAY_ONLY=1 and a long RCFD_BENCH_STEPS show it.
   const int warmup = options.quick ? 20 : 400;
   // 100 timed steps: one period of the synthetic field and one interval of the tracers' sort by cell,
-  // sort included (until 2026-12-02: 40 steps, frames 60-99 and no sort). RCFD_BENCH_STEPS overrides.
+  // sort included. RCFD_BENCH_STEPS overrides.
   int steps = options.quick ? 5 : 100;
   if (const char* e = std::getenv("RCFD_BENCH_STEPS")) steps = std::max(1, std::atoi(e));
   if (const char* e = std::getenv("RCFD_BENCH_INTEGRATOR")) scene.rcfd.integrator = e;
 
   // The tracer step alone and with the spray stage, timed in alternation step by step over the same
-  // steps of the same field (until 2026-12-02 one after the other, when the VM's drift between the two
-  // halves could show as a spray overhead of -7% or +54%).
+  // steps of the same field: timed one after the other, a virtual machine's drift between the two halves
+  // can show as a spray overhead anywhere from -7 % to +54 %.
   Scene tracerScene = scene;
   tracerScene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction"};
   scene.effects = {"transport", "walls", "fluctuation", "tracer_volume_fraction",

@@ -11,8 +11,7 @@
 // counterUnitVector()) and the cells of the moved positions for the next step (CellIndexer::cellsOf()).
 // `midpoint_float` prices the midpoint floor with the lanes' arithmetic in float (positions stay double;
 // grid coordinates, velocities and displacements are float, so a vector holds 16 lanes instead of 8);
-// since 2026-12-03 the kernel locates and takes midpoints in float grid coordinates as it does, with the
-// same functions, and keeps its displacements in double. `midpoint_float_fluctuation_next_cells` adds
+// the kernel locates and takes midpoints in float grid coordinates as it does, with the same functions, and keeps its displacements in double. `midpoint_float_fluctuation_next_cells` adds
 // the Eq. (10) direction in float (counterUnitVectorFloat(), as the kernel) and the next cells to it: the
 // floor of the kernel's own arithmetic, which no walls and no sub-steps can undercut.
 // `midpoint_gradient` prices a one-sample second-order step (floorStepGradient());

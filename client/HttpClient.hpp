@@ -1,14 +1,21 @@
 #pragma once
 /// \file HttpClient.hpp
 /// A small synchronous HTTP/1.1 client (Boost.Beast) for the rcfd client: one connection per
-/// request, bearer token, JSON bodies, streamed file uploads and downloads.
+/// request, bearer token, JSON bodies, streamed file uploads and downloads; http:// or https:// (the
+/// server's certificate checked against the system's CAs or a given CA file, and its name against the
+/// URL's host).
 
 #include <chrono>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <memory>
 #include <string>
+
+namespace boost::asio::ssl {
+class context;
+}
 
 namespace rcfd::client {
 
@@ -28,9 +35,13 @@ struct HttpResponse {
 
 class HttpClient {
  public:
-  /// `server` like "http://127.0.0.1:8080" (http only); throws std::invalid_argument otherwise.
-  /// Connecting, and each send or receive after it, fails with ConnectionError after `timeout`.
-  HttpClient(const std::string& server, std::string token, std::chrono::seconds timeout = std::chrono::seconds(60));
+  /// `server` like "http://127.0.0.1:8080" or "https://rcfd.lab.example"; throws
+  /// std::invalid_argument otherwise. Connecting, and each send or receive after it, fails with
+  /// ConnectionError after `timeout`. For https, `caFile` (PEM) holds the certificates the server's
+  /// is checked against; empty: the system's.
+  HttpClient(const std::string& server, std::string token, std::chrono::seconds timeout = std::chrono::seconds(60),
+             const std::string& caFile = {});
+  ~HttpClient();
 
   HttpResponse get(const std::string& target);
   HttpResponse post(const std::string& target, const std::string& jsonBody,
@@ -43,8 +54,14 @@ class HttpClient {
   const std::string& server() const { return server_; }
 
  private:
+  /// Connects (and for https does the TLS handshake), then calls `exchange(stream)` with the
+  /// connection's stream and closes it; every step within the timeout.
+  template <class Exchange>
+  void withConnection(Exchange&& exchange);
+
   std::string server_, host_, port_, token_;
   std::chrono::seconds timeout_;
+  std::shared_ptr<boost::asio::ssl::context> tls_;  ///< null for http://
 };
 
 }  // namespace rcfd::client

@@ -110,7 +110,7 @@ void printStatus(const json& job) {
   const auto& p = job["progress"];
   std::cout << "progress:  " << fmtNumber(p["fraction"].is_number() ? json(100 * p["fraction"].get<double>()) : json()) << " %"
             << "  sim_time " << fmtNumber(p["sim_time"]) << " s  eta " << fmtNumber(p["eta_s"]) << " s\n";
-  for (const char* key : {"database", "created_at", "started_at", "finished_at", "error"})
+  for (const char* key : {"owner", "database", "created_at", "started_at", "finished_at", "error"})
     if (job.contains(key) && job[key].is_string())
       std::cout << key << ":" << std::string(std::max<std::size_t>(1, 10 - std::min<std::size_t>(10, std::string(key).size())), ' ')
                 << job[key].get<std::string>() << "\n";
@@ -197,12 +197,16 @@ int main(int argc, char** argv) {
   std::string token = envOr("RCFD_TOKEN", "");
   app.add_option("--server", server, "server URL (env RCFD_SERVER)")->capture_default_str();
   app.add_option("--token", token, "bearer token (env RCFD_TOKEN)");
+  std::string caFile = envOr("RCFD_CACERT", "");
+  app.add_option("--cacert", caFile,
+                 "PEM file of the CA certificates an https:// server's certificate is checked against "
+                 "(env RCFD_CACERT; default: the system's)");
   int timeoutSeconds = std::atoi(envOr("RCFD_TIMEOUT", "60").c_str());
   app.add_option("--timeout", timeoutSeconds, "seconds to wait for the server to connect or answer (env RCFD_TIMEOUT)")
       ->capture_default_str()->check(CLI::Range(1, 86400));
   app.require_subcommand(1);
 
-  std::string file, id, name, output, state, kind, key, format = "csv";
+  std::string file, id, name, output, state, kind, owner, key, format = "csv";
   bool wait = false, asJson = false;
   int bins = 0;
   double interval = 1.0, reconnect = 600.0;
@@ -214,6 +218,7 @@ int main(int argc, char** argv) {
   auto* jobs = app.add_subcommand("jobs", "list jobs");
   jobs->add_option("--state", state, "QUEUED, RUNNING, SUCCEEDED, FAILED, CANCELLING or CANCELLED");
   jobs->add_option("--kind", kind, "database, calibration or spray");
+  jobs->add_option("--owner", owner, "one user's jobs (admins; a user sees only their own anyway)");
   auto* status = app.add_subcommand("status", "show a job");
   status->add_option("ID", id)->required();
   status->add_flag("--json", asJson, "print the job resource as JSON");
@@ -254,7 +259,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    HttpClient client(server, token, std::chrono::seconds(std::max(1, timeoutSeconds)));
+    HttpClient client(server, token, std::chrono::seconds(std::max(1, timeoutSeconds)), caFile);
     if (submit->parsed()) {
       const json body = readJobFile(file);
       std::map<std::string, std::string> headers;
@@ -272,7 +277,8 @@ int main(int argc, char** argv) {
       std::string query = "?page_size=200";
       if (!state.empty()) query += "&state=" + urlEncode(state);
       if (!kind.empty()) query += "&kind=" + urlEncode(kind);
-      std::printf("%-32s  %-11s  %-10s  %7s  %s\n", "ID", "KIND", "STATE", "DONE", "CREATED");
+      if (!owner.empty()) query += "&owner=" + urlEncode(owner);
+      std::printf("%-32s  %-11s  %-10s  %7s  %-12s  %s\n", "ID", "KIND", "STATE", "DONE", "OWNER", "CREATED");
       std::string pageToken;
       do {
         auto res = client.get("/v1/jobs" + query +
@@ -280,9 +286,10 @@ int main(int argc, char** argv) {
         if (!res.ok()) fail(res, "list jobs");
         const auto page = parseJson(res);
         for (const auto& j : page["jobs"])
-          std::printf("%-32s  %-11s  %-10s  %6.1f%%  %s\n", j.value("id", "").c_str(),
+          std::printf("%-32s  %-11s  %-10s  %6.1f%%  %-12s  %s\n", j.value("id", "").c_str(),
                       j.value("kind", "").c_str(), j.value("state", "").c_str(),
-                      100 * j["progress"].value("fraction", 0.0), j.value("created_at", "").c_str());
+                      100 * j["progress"].value("fraction", 0.0), j.value("owner", "").c_str(),
+                      j.value("created_at", "").c_str());
         pageToken = page.value("next_page_token", "");
       } while (!pageToken.empty());
       return kOk;

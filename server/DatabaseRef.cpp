@@ -5,9 +5,11 @@
 
 namespace rcfd::server {
 
-DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, const std::string& ref) {
+DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, const std::string& ref,
+                               const Caller* caller) {
   DatabaseRef out;
-  if (auto job = store.job(ref)) {
+  const auto visible = [&](const std::string& owner) { return !caller || caller->mayAccess(owner); };
+  if (auto job = store.job(ref); job && visible(job->owner)) {
     if (job->kind != "database") {
       out.detail = "job " + ref + " is a " + job->kind + " job, not a database job";
       return out;
@@ -24,7 +26,7 @@ DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, cons
     }
     return out;
   }
-  if (auto db = store.database(ref)) {
+  if (auto db = store.database(ref); db && visible(db->owner)) {
     out.status = DatabaseRef::Status::ready;
     out.path = db->path;
     return out;

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 
+#include "Users.hpp"
+
 namespace rcfd::server {
 
 class JobStore;
@@ -18,6 +20,10 @@ struct DatabaseRef {
   std::string detail;          ///< why it is failed or unknown, for messages
 };
 
-DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, const std::string& ref);
+/// `caller`: whose job names the reference; a database job or upload this caller may not access is
+/// unknown to it, exactly as a wrong id (nothing tells that it exists). nullptr: the server itself (the
+/// worker starting a job accepted earlier), which sees all.
+DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, const std::string& ref,
+                               const Caller* caller = nullptr);
 
 }  // namespace rcfd::server

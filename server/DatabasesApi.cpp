@@ -110,6 +110,7 @@ nlohmann::json toJson(const DatabaseRecord& db) {
           {"frames", db.frames},
           {"bytes", db.bytes},
           {"created_at", db.createdAt},
+          {"owner", db.owner},
           {"links", {{"self", "/v1/databases/" + db.id}}}};
 }
 }  // namespace
@@ -120,7 +121,8 @@ std::filesystem::path DatabasesApi::temporaryUploadPath() const {
   return dir / (newId() + ".h5.part");
 }
 
-StringResponse DatabasesApi::accept(const std::filesystem::path& file, const Target& target) {
+StringResponse DatabasesApi::accept(const std::filesystem::path& file, const Target& target,
+                                    const Caller& caller) {
   std::error_code ec;
   const auto bytes = std::filesystem::file_size(file, ec);
   if (ec || bytes == 0) {
@@ -159,6 +161,7 @@ StringResponse DatabasesApi::accept(const std::filesystem::path& file, const Tar
   db.bytes = static_cast<std::int64_t>(bytes);
   db.path = (config_.databaseDir() / (db.id + ".h5")).string();
   db.createdAt = nowRfc3339();
+  db.owner = caller.name;
   std::filesystem::rename(file, db.path, ec);
   if (ec) {
     std::filesystem::remove(file, ec);
@@ -191,9 +194,9 @@ int checkUploadedDatabase(const std::filesystem::path& file) {
   return 0;
 }
 
-Response DatabasesApi::get(const std::string& id, const Target& target) {
+Response DatabasesApi::get(const std::string& id, const Target& target, const Caller& caller) {
   const auto db = store_.database(id);
-  if (!db)
+  if (!db || !caller.mayAccess(db->owner))
     return problem(http::status::not_found, "database-not-found", "Database not found",
                    "there is no uploaded database with id \"" + id + "\"", target.path);
   return jsonResponse(http::status::ok, toJson(*db));

@@ -4,7 +4,7 @@
 /// to a temporary file by HttpSession, validated with rcfd::FieldDatabase::open in a child
 /// process (HDF5 can crash or loop on a damaged file: only the child goes, killed after
 /// --upload-check-timeout) and only then kept under DIR/databases/<id>.h5. GET /v1/databases/{id}
-/// describes one.
+/// describes one to its uploader or an admin (to anyone else it does not exist: 404).
 
 #include <filesystem>
 #include <string_view>
@@ -13,6 +13,7 @@
 #include "JobStore.hpp"
 #include "ServerConfig.hpp"
 #include "Target.hpp"
+#include "Users.hpp"
 
 namespace rcfd::server {
 
@@ -30,10 +31,10 @@ class DatabasesApi {
 
   /// Where the session streams an upload before validation (unique per call).
   std::filesystem::path temporaryUploadPath() const;
-  /// Validates the uploaded file and registers it (201) or deletes it (422). Blocking: waits for the
-  /// validating child; call it off the io_context threads.
-  StringResponse accept(const std::filesystem::path& file, const Target& target);
-  Response get(const std::string& id, const Target& target);
+  /// Validates the uploaded file and registers it as `caller`'s (201) or deletes it (422). Blocking:
+  /// waits for the validating child; call it off the io_context threads.
+  StringResponse accept(const std::filesystem::path& file, const Target& target, const Caller& caller);
+  Response get(const std::string& id, const Target& target, const Caller& caller);
 
  private:
   JobStore& store_;

@@ -20,27 +20,78 @@ constexpr auto kDrainTimeout = std::chrono::seconds(5);
 Response withoutBody(Response&& res) {
   return std::visit([](auto& message) -> Response { return StringResponse(std::move(message.base())); }, res);
 }
+
+/// Ends of a read that are the peer going away, not a request to answer: the connection just closes.
+/// Over TLS this includes a TCP close without close_notify (stream_truncated) and any TLS failure: a
+/// stream that broke cannot carry an answer.
+bool isPeerGone(const beast::error_code& ec) {
+  return ec == http::error::end_of_stream || ec == net::error::eof || ec == net::error::connection_reset ||
+         ec == beast::error::timeout || ec == net::error::operation_aborted ||
+         ec == net::ssl::error::stream_truncated || ec.category() == net::error::get_ssl_category();
+}
 }  // namespace
 
-HttpSession::HttpSession(net::ip::tcp::socket&& socket, Router& router, net::thread_pool& blocking,
-                         std::shared_ptr<void> ticket)
+template <class Stream>
+HttpSession<Stream>::HttpSession(net::ip::tcp::socket&& socket, Router& router, net::thread_pool& blocking,
+                                 std::shared_ptr<void> ticket)
+  requires(!kTls)
     : stream_(std::move(socket)), router_(router), blocking_(blocking), ticket_(std::move(ticket)) {}
 
-HttpSession::~HttpSession() {
+template <class Stream>
+HttpSession<Stream>::HttpSession(net::ip::tcp::socket&& socket, net::ssl::context& tls, Router& router,
+                                 net::thread_pool& blocking, std::shared_ptr<void> ticket)
+  requires(kTls)
+    : stream_(std::move(socket), tls), router_(router), blocking_(blocking), ticket_(std::move(ticket)) {}
+
+template <class Stream>
+HttpSession<Stream>::~HttpSession() {
   if (!uploadPath_.empty()) {
     std::error_code ec;
     std::filesystem::remove(uploadPath_, ec);  // an interrupted upload leaves nothing behind
   }
 }
 
-void HttpSession::run() {
-  net::dispatch(stream_.get_executor(),
-                beast::bind_front_handler(&HttpSession::doRead, shared_from_this()));
+template <class Stream>
+void HttpSession<Stream>::run() {
+  if constexpr (kTls) {
+    net::dispatch(stream_.get_executor(), [self = this->shared_from_this()] {
+      // The handshake precedes any token: it gets the short idle time of a connection without one.
+      const auto& config = self->router_.config();
+      self->tcp().expires_after(std::min(config.readTimeout, config.idleBeforeToken));
+      self->stream_.async_handshake(net::ssl::stream_base::server,
+                                    beast::bind_front_handler(&HttpSession::onHandshake, self));
+    });
+  } else {
+    net::dispatch(stream_.get_executor(),
+                  beast::bind_front_handler(&HttpSession::doRead, this->shared_from_this()));
+  }
 }
 
-void HttpSession::doRead() {
+template <class Stream>
+void HttpSession<Stream>::onHandshake(beast::error_code ec) {
+  if (!ec) return doRead();
+  // Not TLS (a plain HTTP request to the HTTPS port), an unacceptable version, or too slow: there is
+  // no channel to answer on.
+  beast::error_code ignored;
+  tcp().socket().close(ignored);
+}
+
+template <class Stream>
+void HttpSession<Stream>::tlsShutdown() {
+  if constexpr (kTls) {
+    tcp().expires_after(kDrainTimeout);
+    stream_.async_shutdown([self = this->shared_from_this()](beast::error_code) {
+      beast::error_code ignored;
+      self->tcp().socket().close(ignored);
+    });
+  }
+}
+
+template <class Stream>
+void HttpSession<Stream>::doRead() {
   header_.emplace();
   header_->header_limit(kHeaderLimit);
+  caller_.reset();
   // No limit here: the route's own limit is checked against Content-Length once the route is known
   // (onHeader), and the route's body parser enforces it on chunked bodies.
   // (Not boost::none: Beast 1.74 compares a Content-Length with an empty optional as "over".)
@@ -50,15 +101,22 @@ void HttpSession::doRead() {
   head_ = false;
   // A connection that never sent a token holds a descriptor for a few seconds only.
   const auto& config = router_.config();
-  stream_.expires_after(tokenSeen_ ? config.readTimeout : std::min(config.readTimeout, config.idleBeforeToken));
+  tcp().expires_after(tokenSeen_ ? config.readTimeout : std::min(config.readTimeout, config.idleBeforeToken));
   http::async_read_header(stream_, buffer_, *header_,
-                          beast::bind_front_handler(&HttpSession::onHeader, shared_from_this()));
+                          beast::bind_front_handler(&HttpSession::onHeader, this->shared_from_this()));
 }
 
-void HttpSession::readError(beast::error_code ec) {
-  if (ec == http::error::end_of_stream || ec == net::error::eof ||
-      ec == net::error::connection_reset || ec == beast::error::timeout ||
-      ec == net::error::operation_aborted) {
+template <class Stream>
+void HttpSession<Stream>::readError(beast::error_code ec) {
+  if constexpr (kTls) {
+    if (isPeerGone(ec)) {
+      // A peer that said goodbye (close_notify) gets ours; one that broke the stream, nothing.
+      if (ec == http::error::end_of_stream || ec == net::error::eof) return tlsShutdown();
+      beast::error_code ignored;
+      tcp().socket().close(ignored);
+      return;
+    }
+  } else if (isPeerGone(ec)) {
     beast::error_code ignored;
     stream_.socket().shutdown(net::ip::tcp::socket::shutdown_send, ignored);
     return;
@@ -82,7 +140,8 @@ void HttpSession::readError(beast::error_code ec) {
        false);
 }
 
-std::string HttpSession::instanceOfFailedRead() const {
+template <class Stream>
+std::string HttpSession<Stream>::instanceOfFailedRead() const {
   // The parser that failed holds the target once it has read the request line. The header is parsed
   // only when complete, so a header over the limit fails before that: then the target is taken from
   // the request line still unread in the buffer.
@@ -102,7 +161,8 @@ std::string HttpSession::instanceOfFailedRead() const {
   return instancePath(target);
 }
 
-bool HttpSession::failedReadIsHead() const {
+template <class Stream>
+bool HttpSession<Stream>::failedReadIsHead() const {
   if (body_ || upload_) return head_;
   if (header_ && header_->get().method() == http::verb::head) return true;  // its request line was parsed
   const auto unread = buffer_.data();
@@ -110,18 +170,20 @@ bool HttpSession::failedReadIsHead() const {
   return requestLine.rfind("HEAD ", 0) == 0;
 }
 
-void HttpSession::onHeader(beast::error_code ec, std::size_t) {
+template <class Stream>
+void HttpSession<Stream>::onHeader(beast::error_code ec, std::size_t) {
   if (ec) return readError(ec);
   started_ = std::chrono::steady_clock::now();
   const auto& req = header_->get();
   head_ = req.method() == http::verb::head;
   tokenSeen_ = tokenSeen_ || req.find(http::field::authorization) != req.end();
-  stream_.expires_after(router_.config().readTimeout);  // the body may take the full read time
+  tcp().expires_after(router_.config().readTimeout);  // the body may take the full read time
   const std::string_view target(req.target().data(), req.target().size());
   const std::string instance = instancePath(target);
   // Nothing about a request (its size, its body's syntax) is judged for a client without the token:
   // it gets 401 before its body is read, and the connection closes, discarding that body.
-  if (!Router::isPublic(req.method(), target) && !router_.authorized(req))
+  caller_ = router_.authenticate(req);
+  if (!Router::isPublic(req.method(), target) && !caller_)
     return send(router_.unauthorized(instance), false);
   const auto tooLarge = [&](std::uint64_t length, std::uint64_t limit) {
     return problem(http::status::payload_too_large, "body-too-large", "Request body too large",
@@ -142,9 +204,9 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
       return send(problem(http::status::internal_server_error, "storage-failed", "Storage failed",
                           "cannot create the upload file: " + fileError.message(), instance),
                   false);
-    stream_.expires_after(router_.config().uploadTimeout);
+    tcp().expires_after(router_.config().uploadTimeout);
     http::async_read(stream_, buffer_, *upload_,
-                     beast::bind_front_handler(&HttpSession::onUpload, shared_from_this()));
+                     beast::bind_front_handler(&HttpSession::onUpload, this->shared_from_this()));
     return;
   }
   if (length && *length > router_.config().jsonBodyLimit)
@@ -153,28 +215,32 @@ void HttpSession::onHeader(beast::error_code ec, std::size_t) {
   body_->body_limit(router_.config().jsonBodyLimit);
   if (body_->is_done()) return onBody({}, 0);  // no body (a GET): answer without another read
   http::async_read(stream_, buffer_, *body_,
-                   beast::bind_front_handler(&HttpSession::onBody, shared_from_this()));
+                   beast::bind_front_handler(&HttpSession::onBody, this->shared_from_this()));
 }
 
-void HttpSession::onBody(beast::error_code ec, std::size_t) {
+template <class Stream>
+void HttpSession<Stream>::onBody(beast::error_code ec, std::size_t) {
   if (ec) return readError(ec);
   started_ = std::chrono::steady_clock::now();
   Request req = body_->release();
   const bool keepAlive = req.keep_alive();
   // Handlers only read and write short SQLite rows or small files, so they run here on the strand.
-  send(router_.handle(req), keepAlive);
+  send(router_.handle(req, caller_), keepAlive);
 }
 
-void HttpSession::onUpload(beast::error_code ec, std::size_t) {
+template <class Stream>
+void HttpSession<Stream>::onUpload(beast::error_code ec, std::size_t) {
   if (ec) return readError(ec);
   auto req = upload_->release();
   req.body().close();
   const bool keepAlive = req.keep_alive();
   const auto target = parseTarget(std::string(req.target()));
   // Validation opens the HDF5 file: off the io threads, then back to this strand to answer.
-  net::post(blocking_, [self = shared_from_this(), keepAlive, target] {
+  // The header was authenticated (onHeader): an upload always has its caller.
+  net::post(blocking_, [self = this->shared_from_this(), keepAlive, target, caller = *caller_] {
     auto path = self->uploadPath_;
-    StringResponse res = self->router_.databases().accept(path, target.value_or(Target{"/v1/databases", {}, {}, false}));
+    StringResponse res =
+        self->router_.databases().accept(path, target.value_or(Target{"/v1/databases", {}, {}, false}), caller);
     net::post(self->stream_.get_executor(), [self, keepAlive, res = std::move(res)]() mutable {
       self->uploadPath_.clear();  // moved into place or deleted by accept()
       self->send(std::move(res), keepAlive);
@@ -182,7 +248,8 @@ void HttpSession::onUpload(beast::error_code ec, std::size_t) {
   });
 }
 
-void HttpSession::send(Response&& res, bool keepAlive) {
+template <class Stream>
+void HttpSession<Stream>::send(Response&& res, bool keepAlive) {
   if (head_) res = withoutBody(std::move(res));
   std::visit(
       [&](auto& message) {
@@ -193,13 +260,14 @@ void HttpSession::send(Response&& res, bool keepAlive) {
         status_ = static_cast<int>(sp->result_int());
         response_ = sp;
         http::async_write(stream_, *sp,
-                          beast::bind_front_handler(&HttpSession::onWrite, shared_from_this(),
+                          beast::bind_front_handler(&HttpSession::onWrite, this->shared_from_this(),
                                                     sp->need_eof()));
       },
       res);
 }
 
-void HttpSession::onWrite(bool close, beast::error_code ec, std::size_t) {
+template <class Stream>
+void HttpSession<Stream>::onWrite(bool close, beast::error_code ec, std::size_t) {
   router_.metrics().observe(
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count(), status_);
   response_.reset();
@@ -208,25 +276,48 @@ void HttpSession::onWrite(bool close, beast::error_code ec, std::size_t) {
   doRead();
 }
 
-void HttpSession::lingeringClose() {
+template <class Stream>
+void HttpSession<Stream>::lingeringClose() {
   // Closing with unread request bytes makes the kernel send RST, which can destroy the response
-  // before the client reads it; so shut down our side and discard input for a while first.
-  beast::error_code ignored;
-  stream_.socket().shutdown(net::ip::tcp::socket::shutdown_send, ignored);
-  stream_.expires_after(kDrainTimeout);
-  stream_.async_read_some(net::buffer(scratch_),
-                          beast::bind_front_handler(&HttpSession::onDrain, shared_from_this()));
+  // before the client reads it; so shut down our side and discard input for a while first. Over TLS
+  // "our side" is a close_notify first.
+  if constexpr (kTls) {
+    tcp().expires_after(kDrainTimeout);
+    stream_.async_shutdown([self = this->shared_from_this()](beast::error_code ec) {
+      beast::error_code ignored;
+      if (!ec) {  // close_notify both ways: done
+        self->tcp().socket().close(ignored);
+        return;
+      }
+      // Our close_notify is out (OpenSSL sends it before it fails), but the peer is still sending (the
+      // body of a request answered from its header), which TLS refuses after close_notify ("application
+      // data after close notify"): that rest is read and discarded below TLS, as the plain drain does.
+      self->tcp().socket().shutdown(net::ip::tcp::socket::shutdown_send, ignored);
+      self->tcp().async_read_some(net::buffer(self->scratch_),
+                                  beast::bind_front_handler(&HttpSession::onDrain, self));
+    });
+  } else {
+    beast::error_code ignored;
+    stream_.socket().shutdown(net::ip::tcp::socket::shutdown_send, ignored);
+    stream_.expires_after(kDrainTimeout);
+    stream_.async_read_some(net::buffer(scratch_),
+                            beast::bind_front_handler(&HttpSession::onDrain, this->shared_from_this()));
+  }
 }
 
-void HttpSession::onDrain(beast::error_code ec, std::size_t n) {
+template <class Stream>
+void HttpSession<Stream>::onDrain(beast::error_code ec, std::size_t n) {
   drained_ += n;
   if (ec || drained_ > kDrainLimit) {
     beast::error_code ignored;
-    stream_.socket().close(ignored);
+    tcp().socket().close(ignored);
     return;
   }
-  stream_.async_read_some(net::buffer(scratch_),
-                          beast::bind_front_handler(&HttpSession::onDrain, shared_from_this()));
+  tcp().async_read_some(net::buffer(scratch_),
+                        beast::bind_front_handler(&HttpSession::onDrain, this->shared_from_this()));
 }
+
+template class HttpSession<PlainStream>;
+template class HttpSession<TlsStream>;
 
 }  // namespace rcfd::server

@@ -10,30 +10,54 @@
 /// 9110 9.3.2), whatever the route answered, so the next response on the connection is not read
 /// from its body. Uploads are validated on the blocking pool (which waits for the validating child
 /// process, DatabasesApi), never on an io thread.
+///
+/// The session is a template on its stream: PlainStream (HTTP) or TlsStream (HTTPS, --tls-cert): the
+/// TLS session first does the handshake (within the idle time before a token) and ends with a TLS
+/// close_notify instead of a TCP half-close; everything between is the same code, and the plain
+/// session has no branch or indirection it did not have before.
 
 #include <boost/asio/thread_pool.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <type_traits>
 
 #include "HttpTypes.hpp"
 #include "Router.hpp"
+#include "Users.hpp"
 
 namespace rcfd::server {
 
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+using PlainStream = boost::beast::tcp_stream;
+using TlsStream = boost::beast::ssl_stream<boost::beast::tcp_stream>;
+
+template <class Stream>
+class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
  public:
+  static constexpr bool kTls = std::is_same_v<Stream, TlsStream>;
+
   /// `ticket` is held as long as the connection is open (the listener's count of open connections).
   HttpSession(boost::asio::ip::tcp::socket&& socket, Router& router, boost::asio::thread_pool& blocking,
-              std::shared_ptr<void> ticket = {});
+              std::shared_ptr<void> ticket = {})
+    requires(!kTls);
+  /// An HTTPS connection with the server's certificate and key in `tls`.
+  HttpSession(boost::asio::ip::tcp::socket&& socket, boost::asio::ssl::context& tls, Router& router,
+              boost::asio::thread_pool& blocking, std::shared_ptr<void> ticket = {})
+    requires(kTls);
   ~HttpSession();
-  /// Starts reading on the session's strand.
+  /// Starts the session (the TLS handshake, then reading) on its strand.
   void run();
 
  private:
+  boost::beast::tcp_stream& tcp() { return boost::beast::get_lowest_layer(stream_); }
+  void onHandshake(boost::beast::error_code ec);
+  /// Ends a TLS connection whose peer said goodbye: our close_notify, then the socket is closed.
+  void tlsShutdown();
   void doRead();
   void onHeader(boost::beast::error_code ec, std::size_t);
   void onBody(boost::beast::error_code ec, std::size_t);
@@ -50,7 +74,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   /// read from the request line still unread in the buffer.
   bool failedReadIsHead() const;
 
-  boost::beast::tcp_stream stream_;
+  Stream stream_;
   boost::beast::flat_buffer buffer_;
   Router& router_;
   boost::asio::thread_pool& blocking_;
@@ -64,6 +88,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   std::size_t drained_ = 0;
   std::array<char, 16384> scratch_{};
   std::shared_ptr<void> ticket_;
+  std::optional<Caller> caller_;  ///< whom the request being answered came from (Router::authenticate)
   bool tokenSeen_ = false;  ///< a request carried an Authorization header: the long idle time applies
   bool head_ = false;       ///< the request answered is a HEAD: its response goes without a body
 };

@@ -34,7 +34,7 @@ namespace {
 
 // Ordered migrations: entry i brings the schema from version i to i + 1. Never edit a released
 // entry; append a new one.
-const std::array<const char*, 2> kMigrations = {
+const std::array<const char*, 3> kMigrations = {
     R"sql(
 CREATE TABLE jobs (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -88,7 +88,27 @@ CREATE TABLE databases (
   frames INTEGER NOT NULL,
   created_at TEXT NOT NULL
 );
+)sql",
+    // Users: jobs and uploads have an owner; what existed before belongs to the single token's user.
+    // Idempotency keys become per owner (see scopedKey): the old ones are the admin's.
+    R"sql(
+ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT 'admin';
+UPDATE jobs SET idempotency_key = 'admin/' || idempotency_key WHERE idempotency_key IS NOT NULL;
+CREATE INDEX jobs_by_owner ON jobs(owner, seq);
+ALTER TABLE databases ADD COLUMN owner TEXT NOT NULL DEFAULT 'admin';
 )sql"};
+
+/// The stored form of an Idempotency-Key: OWNER/KEY. Keys are names clients choose ("quick-db-1"), so
+/// two users may pick the same one, and one's key must neither replay nor reveal the other's job.
+/// The column is UNIQUE since the first schema, and SQLite cannot drop that without rebuilding the
+/// table, so the owner goes into the value (names never hold a "/").
+std::string scopedKey(const std::string& owner, const std::string& key) {
+  return key.empty() ? key : owner + "/" + key;
+}
+std::string unscopedKey(const std::string& stored) {
+  const auto slash = stored.find('/');
+  return slash == std::string::npos ? stored : stored.substr(slash + 1);
+}
 
 /// A prepared statement that finalizes itself.
 class Statement {
@@ -193,7 +213,7 @@ class Transaction {
 
 constexpr const char* kJobColumns =
     "seq, id, kind, state, request, idempotency_key, body_hash, database_ref, progress, sim_time, "
-    "wall_time, eta_s, created_at, started_at, finished_at, updated_at, error, attempt";
+    "wall_time, eta_s, created_at, started_at, finished_at, updated_at, error, attempt, owner";
 
 void insertEvent(sqlite3* db, const std::string& id, const std::string& from, const std::string& to,
                  const std::string& reason, const std::string& at) {
@@ -287,7 +307,7 @@ JobRecord JobStore::readJob(void* statement) {
   j.kind = s.text(2);
   j.state = s.text(3);
   j.request = s.text(4);
-  j.idempotencyKey = s.text(5);
+  j.idempotencyKey = unscopedKey(s.text(5));
   j.bodyHash = s.text(6);
   j.databaseRef = s.text(7);
   j.progress = s.real(8);
@@ -300,26 +320,29 @@ JobRecord JobStore::readJob(void* statement) {
   j.updatedAt = s.text(15);
   j.error = s.text(16);
   j.attempt = static_cast<int>(s.integer(17));
+  j.owner = s.text(18);
   return j;
 }
 
 JobStore::InsertResult JobStore::insertJob(const JobRecord& job) {
   std::lock_guard lock(mutex_);
   Transaction tx(db_);
-  if (!job.idempotencyKey.empty()) {
+  if (job.owner.empty()) throw std::logic_error("a job needs an owner");
+  const std::string key = scopedKey(job.owner, job.idempotencyKey);
+  if (!key.empty()) {
     Statement existing(db_, (std::string("SELECT ") + kJobColumns +
                              " FROM jobs WHERE idempotency_key = ?1").c_str());
-    existing.bind(1, job.idempotencyKey);
+    existing.bind(1, key);
     if (existing.step()) return {readJob(&existing), false};
   }
   const std::string now = nowRfc3339();
   Statement insert(db_,
                    "INSERT INTO jobs(id, kind, state, request, idempotency_key, body_hash, "
-                   "database_ref, created_at, updated_at) VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?8)");
+                   "database_ref, created_at, updated_at, owner) VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9)");
   insert.bind(1, job.id).bind(2, job.kind).bind(3, std::string(state::queued)).bind(4, job.request);
-  insert.bindOrNull(5, job.idempotencyKey).bind(6, job.bodyHash).bindOrNull(7, job.databaseRef);
-  insert.bind(8, now).run();
-  insertEvent(db_, job.id, {}, state::queued, "submitted", now);
+  insert.bindOrNull(5, key).bind(6, job.bodyHash).bindOrNull(7, job.databaseRef);
+  insert.bind(8, now).bind(9, job.owner).run();
+  insertEvent(db_, job.id, {}, state::queued, "submitted by " + job.owner, now);
   Statement read(db_, std::string("SELECT ") + kJobColumns + " FROM jobs WHERE id = ?1", &statements_);
   read.bind(1, job.id).step();
   JobRecord created = readJob(&read);
@@ -340,10 +363,10 @@ std::vector<JobRecord> JobStore::listJobs(const JobFilter& filter) {
   std::lock_guard lock(mutex_);
   Statement s(db_, (std::string("SELECT ") + kJobColumns +
                     " FROM jobs WHERE seq > ?1 AND (?2 IS NULL OR state = ?2) AND "
-                    "(?3 IS NULL OR kind = ?3) ORDER BY seq LIMIT ?4")
+                    "(?3 IS NULL OR kind = ?3) AND (?5 IS NULL OR owner = ?5) ORDER BY seq LIMIT ?4")
                        .c_str());
   s.bind(1, filter.afterSeq).bindOrNull(2, filter.state).bindOrNull(3, filter.kind);
-  s.bind(4, static_cast<std::int64_t>(filter.limit));
+  s.bind(4, static_cast<std::int64_t>(filter.limit)).bindOrNull(5, filter.owner);
   std::vector<JobRecord> out;
   while (s.step()) out.push_back(readJob(&s));
   return out;
@@ -473,14 +496,15 @@ std::vector<CoverageBin> JobStore::coverage(const std::string& id) {
 void JobStore::insertDatabase(const DatabaseRecord& db) {
   std::lock_guard lock(mutex_);
   Statement s(db_,
-              "INSERT INTO databases(id, path, bytes, frames, created_at) VALUES(?1, ?2, ?3, ?4, ?5)");
+              "INSERT INTO databases(id, path, bytes, frames, created_at, owner) VALUES(?1, ?2, ?3, ?4, ?5, ?6)");
+  if (db.owner.empty()) throw std::logic_error("a database needs an owner");
   s.bind(1, db.id).bind(2, db.path).bind(3, db.bytes).bind(4, static_cast<std::int64_t>(db.frames));
-  s.bind(5, db.createdAt.empty() ? nowRfc3339() : db.createdAt).run();
+  s.bind(5, db.createdAt.empty() ? nowRfc3339() : db.createdAt).bind(6, db.owner).run();
 }
 
 std::optional<DatabaseRecord> JobStore::database(const std::string& id) {
   std::lock_guard lock(mutex_);
-  Statement s(db_, "SELECT id, path, bytes, frames, created_at FROM databases WHERE id = ?1");
+  Statement s(db_, "SELECT id, path, bytes, frames, created_at, owner FROM databases WHERE id = ?1");
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
   DatabaseRecord d;
@@ -489,6 +513,7 @@ std::optional<DatabaseRecord> JobStore::database(const std::string& id) {
   d.bytes = s.integer(2);
   d.frames = static_cast<int>(s.integer(3));
   d.createdAt = s.text(4);
+  d.owner = s.text(5);
   return d;
 }
 

@@ -48,6 +48,7 @@ struct JobRecord {
   std::string createdAt, startedAt, finishedAt, updatedAt;  ///< RFC 3339 UTC, empty if not yet
   std::string error;
   int attempt = 0;               ///< number of times a worker started the job
+  std::string owner;             ///< the user who submitted it (Users.hpp)
 };
 
 /// One bin of a job's coverage histogram.
@@ -60,6 +61,7 @@ struct DatabaseRecord {
   std::string id, path, createdAt;
   std::int64_t bytes = 0;
   int frames = 0;
+  std::string owner;  ///< the user who uploaded it
 };
 
 /// A state transition of a job (job_events).
@@ -70,6 +72,7 @@ struct JobEvent {
 struct JobFilter {
   std::string state;  ///< empty: any
   std::string kind;   ///< empty: any
+  std::string owner;  ///< empty: anyone's
   std::int64_t afterSeq = 0;
   int limit = 50;
 };
@@ -86,8 +89,9 @@ class JobStore {
   int schemaVersion();
   static int latestSchemaVersion();
 
-  /// Inserts a new QUEUED job. If `job.idempotencyKey` is already used, nothing is inserted and the
-  /// existing job is returned with `created == false` (the caller compares body hashes).
+  /// Inserts a new QUEUED job owned by `job.owner`, its first event saying so. If `job.owner` already
+  /// used `job.idempotencyKey`, nothing is inserted and that job is returned with `created == false`
+  /// (the caller compares body hashes); keys are per owner.
   struct InsertResult {
     JobRecord job;
     bool created = false;

@@ -133,6 +133,12 @@ JobsApi::JobsApi(JobStore& store, WorkerPool& pool, const ServerConfig& config)
 
 JobsApi::~JobsApi() { store_.setChangeListener({}); }
 
+std::optional<JobRecord> JobsApi::visibleJob(const std::string& id, const Caller& caller) {
+  auto job = store_.job(id);
+  if (!job || !caller.mayAccess(job->owner)) return std::nullopt;
+  return job;
+}
+
 bool isArtifactName(const std::string& name) {
   for (const char* fixed : kFixedArtifacts)
     if (name == fixed) return true;
@@ -170,6 +176,7 @@ nlohmann::json JobsApi::toJson(const JobRecord& job, bool withRequest) const {
       {"id", job.id},
       {"kind", job.kind},
       {"state", job.state},
+      {"owner", job.owner},
       {"progress",
        {{"fraction", job.progress},
         {"sim_time", optNum(job.simTime)},
@@ -195,7 +202,7 @@ nlohmann::json JobsApi::toJson(const JobRecord& job, bool withRequest) const {
   return j;
 }
 
-Response JobsApi::submit(const Request& req, const Target& target) {
+Response JobsApi::submit(const Request& req, const Target& target, const Caller& caller) {
   // A job is JSON: a form or text body is refused before it is parsed.
   const auto type = req.find(http::field::content_type);
   std::string_view media = type == req.end() ? std::string_view() : std::string_view(type->value().data(), type->value().size());
@@ -242,7 +249,7 @@ Response JobsApi::submit(const Request& req, const Target& target) {
                                        " jobs: the id of a database job or an uploaded database"),
                         target.path);
   if (!spec.database.empty()) {
-    const DatabaseRef ref = resolveDatabaseRef(store_, config_, spec.database);
+    const DatabaseRef ref = resolveDatabaseRef(store_, config_, spec.database, &caller);
     if (ref.status == DatabaseRef::Status::unknown || ref.status == DatabaseRef::Status::failed)
       return invalidInput(InputError("job", "/database", ref.detail), target.path);
   }
@@ -261,6 +268,7 @@ Response JobsApi::submit(const Request& req, const Target& target) {
   job.bodyHash = bodyHash(job.request);
   job.idempotencyKey = key;
   job.databaseRef = spec.database;
+  job.owner = caller.name;
   const auto inserted = store_.insertJob(job);
   if (!inserted.created && inserted.job.bodyHash != job.bodyHash)
     return problem(http::status::unprocessable_entity, "idempotency-key-reused",
@@ -276,9 +284,16 @@ Response JobsApi::submit(const Request& req, const Target& target) {
   return res;
 }
 
-Response JobsApi::list(const Target& target) {
+Response JobsApi::list(const Target& target, const Caller& caller) {
   JobFilter filter;
   filter.limit = kDefaultPageSize;
+  // A plain user lists their own jobs whatever they ask for; ?owner= narrows an admin's listing.
+  filter.owner = caller.admin ? std::string() : caller.name;
+  bool othersOnly = false;  // a plain user asked for someone else's jobs: none to show
+  if (auto it = target.query.find("owner"); it != target.query.end()) {
+    if (caller.admin) filter.owner = it->second;
+    else othersOnly = it->second != caller.name;
+  }
   if (auto it = target.query.find("state"); it != target.query.end()) {
     if (!state::isValid(it->second))
       return badParameter("state", quotedValue(it->second) +
@@ -311,8 +326,10 @@ Response JobsApi::list(const Target& target) {
     // Signed (PageToken.hpp): a token the server did not issue is refused, however well formed.
     const auto verified = verifyPageToken(it->second, config_.pageTokenKey);
     const nlohmann::json token = verified ? *verified : nlohmann::json();
+    // The owner filter is in it too: a token issued to one user is refused to another.
     if (!token.is_object() || !token.contains("after") || !token["after"].is_number_integer() ||
-        token.value("state", "") != filter.state || token.value("kind", "") != filter.kind)
+        token.value("state", "") != filter.state || token.value("kind", "") != filter.kind ||
+        token.value("owner", "") != filter.owner)
       return badParameter("page_token",
                           "not a token from a previous page of this listing (same filters)", target);
     filter.afterSeq = token["after"].get<std::int64_t>();
@@ -320,37 +337,41 @@ Response JobsApi::list(const Target& target) {
   // Fetch one more than asked: whether it exists decides if there is a next page.
   const int pageSize = filter.limit;
   filter.limit = pageSize + 1;
-  auto rows = store_.listJobs(filter);
+  auto rows = othersOnly ? std::vector<JobRecord>() : store_.listJobs(filter);
   nlohmann::json body = {{"jobs", nlohmann::json::array()}};
   const bool more = static_cast<int>(rows.size()) > pageSize;
   if (more) rows.resize(static_cast<std::size_t>(pageSize));
   for (const auto& job : rows) body["jobs"].push_back(toJson(job));
   if (more) {
-    const nlohmann::json token = {
-        {"after", rows.back().seq}, {"state", filter.state}, {"kind", filter.kind}};
+    nlohmann::json token = {{"after", rows.back().seq}, {"state", filter.state}, {"kind", filter.kind}};
+    // Only when set: an admin's unfiltered listing has tokens without an owner, as a single-token server's.
+    if (!filter.owner.empty()) token["owner"] = filter.owner;
     body["next_page_token"] = signPageToken(token, config_.pageTokenKey);
   }
   return jsonResponse(http::status::ok, body);
 }
 
-Response JobsApi::get(const std::string& id, const Target& target) {
+Response JobsApi::get(const std::string& id, const Target& target, const Caller& caller) {
   const auto view = target.query.find("view");
   if (view != target.query.end() && view->second != "full" && view->second != "basic")
     return badParameter("view", quotedValue(view->second) + " is not one of basic, full", target);
   const bool full = view != target.query.end() && view->second == "full";
   if (!full)
-    if (const auto body = views_.find(id)) return textResponse(http::status::ok, *body, "application/json");
+    if (const auto cached = views_.find(id)) {
+      if (!caller.mayAccess(cached->owner)) return notFound(id, target);
+      return textResponse(http::status::ok, cached->body, "application/json");
+    }
   const auto generation = views_.generation();  // before the read: a write after it voids the body
   const auto job = store_.job(id);
-  if (!job) return notFound(id, target);
+  if (!job || !caller.mayAccess(job->owner)) return notFound(id, target);
   if (full) return jsonResponse(http::status::ok, toJson(*job, true));
-  auto body = std::make_shared<const std::string>(jsonText(toJson(*job)));
-  views_.store(id, body, generation);
-  return textResponse(http::status::ok, *body, "application/json");
+  auto rendered = std::make_shared<const JobViewCache::View>(JobViewCache::View{job->owner, jsonText(toJson(*job))});
+  views_.store(id, rendered, generation);
+  return textResponse(http::status::ok, rendered->body, "application/json");
 }
 
-Response JobsApi::events(const std::string& id, const Target& target) {
-  if (!store_.job(id)) return notFound(id, target);
+Response JobsApi::events(const std::string& id, const Target& target, const Caller& caller) {
+  if (!visibleJob(id, caller)) return notFound(id, target);
   nlohmann::json out = nlohmann::json::array();
   for (const auto& e : store_.events(id))
     out.push_back({{"at", e.at},
@@ -360,20 +381,20 @@ Response JobsApi::events(const std::string& id, const Target& target) {
   return jsonResponse(http::status::ok, {{"events", out}});
 }
 
-Response JobsApi::cancel(const std::string& id, const Target& target) {
+Response JobsApi::cancel(const std::string& id, const Target& target, const Caller& caller) {
   // Compare-and-set loop: the worker pool may move the job between our read and our write.
   for (int attempt = 0; attempt < 5; ++attempt) {
-    const auto job = store_.job(id);
+    const auto job = visibleJob(id, caller);
     if (!job) return notFound(id, target);
     if (state::isFinal(job->state))
       return problem(http::status::conflict, "job-finished", "Job already finished",
                      "job " + id + " is " + job->state + " and cannot be cancelled", target.path);
     if (job->state == state::cancelling) return jsonResponse(http::status::accepted, toJson(*job));
     if (job->state == state::queued &&
-        store_.transition(id, state::queued, state::cancelled, "cancelled by request"))
+        store_.transition(id, state::queued, state::cancelled, "cancelled by " + caller.name))
       return jsonResponse(http::status::ok, toJson(*store_.job(id)));
     if (job->state == state::running &&
-        store_.transition(id, state::running, state::cancelling, "cancel requested")) {
+        store_.transition(id, state::running, state::cancelling, "cancel requested by " + caller.name)) {
       pool_.terminate(id);
       return jsonResponse(http::status::accepted, toJson(*store_.job(id)));
     }
@@ -382,8 +403,8 @@ Response JobsApi::cancel(const std::string& id, const Target& target) {
                  "try the cancel again", target.path);
 }
 
-Response JobsApi::retry(const std::string& id, const Target& target) {
-  const auto job = store_.job(id);
+Response JobsApi::retry(const std::string& id, const Target& target, const Caller& caller) {
+  const auto job = visibleJob(id, caller);
   if (!job) return notFound(id, target);
   if (job->state != state::failed && job->state != state::cancelled)
     return problem(http::status::conflict, "job-not-retryable", "Job cannot be retried",
@@ -391,15 +412,16 @@ Response JobsApi::retry(const std::string& id, const Target& target) {
   std::error_code ec;
   const bool checkpoint = std::filesystem::exists(config_.jobDir(id) / "checkpoint.h5", ec);
   if (!store_.transition(id, job->state, state::queued,
-                         checkpoint ? "retry requested; resumes from its checkpoint"
-                                    : "retry requested; no checkpoint, starts from the beginning"))
+                         "retry requested by " + caller.name +
+                             (checkpoint ? "; resumes from its checkpoint"
+                                         : "; no checkpoint, starts from the beginning")))
     return problem(http::status::conflict, "job-busy", "Job changed state", "try the retry again", target.path);
   pool_.wake();
   return jsonResponse(http::status::ok, toJson(*store_.job(id)));
 }
 
-Response JobsApi::result(const std::string& id, const Target& target) {
-  const auto job = store_.job(id);
+Response JobsApi::result(const std::string& id, const Target& target, const Caller& caller) {
+  const auto job = visibleJob(id, caller);
   if (!job) return notFound(id, target);
   if (job->state != state::succeeded) return notFinished(*job, target, "a result");
   const auto summary = store_.summary(id);
@@ -409,8 +431,8 @@ Response JobsApi::result(const std::string& id, const Target& target) {
   return jsonResponse(http::status::ok, *summary);
 }
 
-Response JobsApi::coverage(const std::string& id, const Target& target) {
-  const auto job = store_.job(id);
+Response JobsApi::coverage(const std::string& id, const Target& target, const Caller& caller) {
+  const auto job = visibleJob(id, caller);
   if (!job) return notFound(id, target);
   if (job->state != state::succeeded) return notFinished(*job, target, "a coverage distribution");
   std::string format = "json";
@@ -440,9 +462,13 @@ Response JobsApi::coverage(const std::string& id, const Target& target) {
                           target);
     bins = mergeBins(stored, n);
   }
-  if (format == "json") return jsonResponse(http::status::ok, coverageJson(id, bins));
+  // An ensemble's band over its members, from the member counts in its summary.
+  std::optional<CoverageBand> band;
+  if (const auto summary = store_.summary(id)) band = coverageBand(*summary, bins.size());
+  const CoverageBand* withBand = band ? &*band : nullptr;
+  if (format == "json") return jsonResponse(http::status::ok, coverageJson(id, bins, withBand));
   if (format == "csv") {
-    auto res = textResponse(http::status::ok, coverageCsv(bins), "text/csv; charset=utf-8");
+    auto res = textResponse(http::status::ok, coverageCsv(bins, withBand), "text/csv; charset=utf-8");
     res.set(http::field::content_disposition, "attachment; filename=\"coverage.csv\"");
     return res;
   }
@@ -458,7 +484,7 @@ Response JobsApi::coverage(const std::string& id, const Target& target) {
   }
   const auto path = config_.jobDir(id) / exportName;
   std::string error;
-  if (!writeCoverageH5(path, id, bins, error))
+  if (!writeCoverageH5(path, id, bins, error, withBand))
     return problem(http::status::internal_server_error, "export-failed", "Export failed", error,
                    target.path);
   const int fd = openJobFile(config_, id, exportName);
@@ -468,13 +494,14 @@ Response JobsApi::coverage(const std::string& id, const Target& target) {
   return fileResponse(fd, "application/x-hdf5", "coverage.h5");
 }
 
-Response JobsApi::artifact(const std::string& id, const std::string& name, const Target& target) {
+Response JobsApi::artifact(const std::string& id, const std::string& name, const Target& target,
+                           const Caller& caller) {
   if (!isArtifactName(name))
     return problem(http::status::bad_request, "invalid-artifact-name", "Invalid artifact name",
                    "\"" + name + "\" is not an artifact name: database.h5, result.h5, summary.json, "
                    "solver.log, job.json or a figure NAME.svg; paths are never accepted",
                    target.path);
-  const auto job = store_.job(id);
+  const auto job = visibleJob(id, caller);
   if (!job) return notFound(id, target);
   // A symlink is never followed, whether the name, the job's folder or jobs/ is one: only files the
   // job wrote into its folder are served, as "not found" otherwise.

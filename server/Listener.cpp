@@ -13,8 +13,8 @@ namespace rcfd::server {
 namespace net = boost::asio;
 
 Listener::Listener(net::io_context& ioc, net::ip::tcp::endpoint endpoint, Router& router,
-                   net::thread_pool& blocking)
-    : ioc_(ioc), acceptor_(net::make_strand(ioc)), router_(router), blocking_(blocking),
+                   net::thread_pool& blocking, net::ssl::context* tls)
+    : ioc_(ioc), acceptor_(net::make_strand(ioc)), router_(router), blocking_(blocking), tls_(tls),
       retry_(acceptor_.get_executor()) {
   acceptor_.open(endpoint.protocol());
   acceptor_.set_option(net::socket_base::reuse_address(true));
@@ -61,8 +61,10 @@ void Listener::onAccept(boost::system::error_code ec, net::ip::tcp::socket socke
                " closed: over the limit of open connections");
     boost::system::error_code ignored;
     socket.close(ignored);
+  } else if (tls_) {
+    std::make_shared<HttpSession<TlsStream>>(std::move(socket), *tls_, router_, blocking_, std::move(ticket))->run();
   } else {
-    std::make_shared<HttpSession>(std::move(socket), router_, blocking_, std::move(ticket))->run();
+    std::make_shared<HttpSession<PlainStream>>(std::move(socket), router_, blocking_, std::move(ticket))->run();
   }
   doAccept();
 }

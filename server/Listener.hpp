@@ -3,9 +3,11 @@
 /// Accepts connections and starts one HttpSession for each, on its own strand. Open connections are
 /// capped in total and per peer address (a connection beyond a cap is closed at once); when accept
 /// fails (descriptors used up) it retries after a back-off of 10 ms doubling to 1 s instead of at
-/// once, and says so on stderr at most once every 10 s.
+/// once, and says so on stderr at most once every 10 s. With a TLS context every connection speaks
+/// HTTPS (HttpSession<TlsStream>), otherwise plain HTTP.
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ssl/context.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/thread_pool.hpp>
 #include <chrono>
@@ -21,9 +23,10 @@ class Router;
 
 class Listener : public std::enable_shared_from_this<Listener> {
  public:
-  /// Binds and listens; throws boost::system::system_error if the endpoint cannot be used.
+  /// Binds and listens; throws boost::system::system_error if the endpoint cannot be used. `tls`
+  /// (outliving the listener and its connections) makes it an HTTPS listener.
   Listener(boost::asio::io_context& ioc, boost::asio::ip::tcp::endpoint endpoint, Router& router,
-           boost::asio::thread_pool& blocking);
+           boost::asio::thread_pool& blocking, boost::asio::ssl::context* tls = nullptr);
   /// The bound endpoint (the real port when 0 was asked for).
   boost::asio::ip::tcp::endpoint endpoint() const { return acceptor_.local_endpoint(); }
   void run();
@@ -43,6 +46,7 @@ class Listener : public std::enable_shared_from_this<Listener> {
   boost::asio::ip::tcp::acceptor acceptor_;
   Router& router_;
   boost::asio::thread_pool& blocking_;
+  boost::asio::ssl::context* tls_;
   boost::asio::steady_timer retry_;
   std::chrono::milliseconds backoff_{0};
   std::chrono::steady_clock::time_point lastLog_{};

@@ -22,14 +22,6 @@ StringResponse noRoute(const Target& target) {
                  "no resource at " + target.path + " (the API lives under /v1; see docs/api.md)",
                  target.path);
 }
-
-/// Constant-time comparison: the time taken does not reveal how much of a token matched.
-bool sameSecret(std::string_view a, std::string_view b) {
-  if (a.size() != b.size() || b.empty()) return false;
-  unsigned char diff = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-  return diff == 0;
-}
 }  // namespace
 
 Router::Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const ServerConfig& config)
@@ -50,15 +42,15 @@ bool Router::isUpload(http::verb method, std::string_view target) {
   return method == http::verb::post && (path == "/v1/databases" || path == "/v1/databases/");
 }
 
-bool Router::authorized(const http::fields& headers) const {
+std::optional<Caller> Router::authenticate(const http::fields& headers) const {
   const auto it = headers.find(http::field::authorization);
-  if (it == headers.end()) return false;
+  if (it == headers.end()) return std::nullopt;
   const std::string_view value(it->value().data(), it->value().size());
   constexpr std::string_view scheme = "Bearer ";
   if (value.size() <= scheme.size() || !boost::beast::iequals(boost::beast::string_view(value.data(), scheme.size()),
                               boost::beast::string_view(scheme.data(), scheme.size())))
-    return false;
-  return sameSecret(value.substr(scheme.size()), config_.token);
+    return std::nullopt;
+  return config_.users.authenticate(value.substr(scheme.size()));
 }
 
 StringResponse Router::unauthorized(const std::string& instance) const {
@@ -70,10 +62,10 @@ StringResponse Router::unauthorized(const std::string& instance) const {
   return res;
 }
 
-Response Router::handle(const Request& req) {
+Response Router::handle(const Request& req, const std::optional<Caller>& caller) {
   const std::string raw(req.target());
   // The token comes first: a client without one learns nothing about its request but that.
-  if (!isPublic(req.method(), raw) && !authorized(req)) return unauthorized(instancePath(raw));
+  if (!isPublic(req.method(), raw) && !caller) return unauthorized(instancePath(raw));
   const auto target = parseTarget(raw);
   if (!target)
     return problem(http::status::bad_request, "invalid-target", "Malformed request target",
@@ -82,14 +74,14 @@ Response Router::handle(const Request& req) {
     return problem(http::status::bad_request, "invalid-target", "Path segments . and .. refused",
                    "resource names are never paths", target->path);
   try {
-    return route(req, *target);
+    return route(req, *target, caller);
   } catch (const std::exception& e) {
     return problem(http::status::internal_server_error, "internal", "Internal server error",
                    e.what(), target->path);
   }
 }
 
-Response Router::route(const Request& req, const Target& target) {
+Response Router::route(const Request& req, const Target& target, const std::optional<Caller>& caller) {
   const auto& s = target.segments;
   const auto method = req.method();
   const bool get = method == http::verb::get;
@@ -110,6 +102,9 @@ Response Router::route(const Request& req, const Target& target) {
                                            {"workers", pool_.slots()},
                                            {"workers_busy", pool_.busy()}});
   }
+  // Only health is public (handle() answered 401 for anything else without a caller).
+  if (!caller) return unauthorized(target.path);
+  const Caller& who = *caller;
   if (s.size() == 3 && s[1] == "schemas") {
     if (!get) return methodNotAllowed(target, "GET");
     try {
@@ -123,38 +118,38 @@ Response Router::route(const Request& req, const Target& target) {
     if (s.size() == 2) return methodNotAllowed(target, "POST");  // uploads are routed by the session
     if (s.size() == 3) {
       if (!get) return methodNotAllowed(target, "GET");
-      return databases_.get(s[2], target);
+      return databases_.get(s[2], target, who);
     }
     return noRoute(target);
   }
   if (s.size() >= 2 && s[1] == "jobs") {
     if (s.size() == 2) {
-      if (post) return jobs_.submit(req, target);
-      if (get) return jobs_.list(target);
+      if (post) return jobs_.submit(req, target, who);
+      if (get) return jobs_.list(target, who);
       return methodNotAllowed(target, "GET, POST");
     }
     std::string id = s[2];
     // Custom method (AIP-136): POST /v1/jobs/{id}:cancel
     if (s.size() == 3 && id.size() > 7 && id.compare(id.size() - 7, 7, ":cancel") == 0) {
       if (!post) return methodNotAllowed(target, "POST");
-      return jobs_.cancel(id.substr(0, id.size() - 7), target);
+      return jobs_.cancel(id.substr(0, id.size() - 7), target, who);
     }
     // POST /v1/jobs/{id}:retry
     if (s.size() == 3 && id.size() > 6 && id.compare(id.size() - 6, 6, ":retry") == 0) {
       if (!post) return methodNotAllowed(target, "POST");
-      return jobs_.retry(id.substr(0, id.size() - 6), target);
+      return jobs_.retry(id.substr(0, id.size() - 6), target, who);
     }
     if (s.size() == 3) {
       if (!get) return methodNotAllowed(target, "GET");
-      return jobs_.get(id, target);
+      return jobs_.get(id, target, who);
     }
     if (s.size() == 4 && !get) return methodNotAllowed(target, "GET");
-    if (s.size() == 4 && s[3] == "result") return jobs_.result(id, target);
-    if (s.size() == 4 && s[3] == "coverage") return jobs_.coverage(id, target);
-    if (s.size() == 4 && s[3] == "events") return jobs_.events(id, target);
+    if (s.size() == 4 && s[3] == "result") return jobs_.result(id, target, who);
+    if (s.size() == 4 && s[3] == "coverage") return jobs_.coverage(id, target, who);
+    if (s.size() == 4 && s[3] == "events") return jobs_.events(id, target, who);
     if (s.size() == 5 && s[3] == "artifacts") {
       if (!get) return methodNotAllowed(target, "GET");
-      return jobs_.artifact(id, s[4], target);
+      return jobs_.artifact(id, s[4], target, who);
     }
     return noRoute(target);
   }

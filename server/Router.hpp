@@ -1,12 +1,15 @@
 #pragma once
 /// \file Router.hpp
-/// Maps a request to its handler (REST shape in STYLE.md), checks the bearer token (everything but
-/// GET /v1/health) and answers health, schema and metrics requests itself.
+/// Maps a request to its handler (REST shape in STYLE.md), authenticates its caller by the bearer token
+/// (everything but GET /v1/health needs one; ServerConfig::users says whose it is) and answers health,
+/// schema and metrics requests itself. Job and database handlers get the caller: what is whose is
+/// decided there.
 
 #include "DatabasesApi.hpp"
 #include "HttpTypes.hpp"
 #include "JobsApi.hpp"
 #include "Metrics.hpp"
+#include "Users.hpp"
 
 namespace rcfd::server {
 
@@ -14,10 +17,11 @@ class Router {
  public:
   Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const ServerConfig& config);
 
-  /// Answers a complete request (JSON body already read and within its size limit).
-  Response handle(const Request& req);
-  /// Whether the header carries "Authorization: Bearer <token>" with the configured token.
-  bool authorized(const http::fields& headers) const;
+  /// Answers a complete request (JSON body already read and within its size limit) for `caller`, as
+  /// authenticate() found it from the request's header (nullopt: no known token; 401 unless public).
+  Response handle(const Request& req, const std::optional<Caller>& caller);
+  /// The user whose token the header's "Authorization: Bearer <token>" carries; nullopt without one.
+  std::optional<Caller> authenticate(const http::fields& headers) const;
   /// Whether the request needs no token.
   static bool isPublic(http::verb method, std::string_view target);
   /// Whether the request body is a database upload (streamed to a file, not held in memory).
@@ -30,7 +34,7 @@ class Router {
   const ServerConfig& config() const { return config_; }
 
  private:
-  Response route(const Request& req, const Target& target);
+  Response route(const Request& req, const Target& target, const std::optional<Caller>& caller);
 
   JobStore& store_;
   WorkerPool& pool_;

@@ -7,12 +7,16 @@
 #include <filesystem>
 #include <string>
 
+#include "Users.hpp"
+
 namespace rcfd::server {
 
 struct ServerConfig {
   std::filesystem::path dataDir;      ///< rcfd.sqlite, jobs/<id>/, databases/
-  std::string token;                  ///< bearer token required on everything but /v1/health
+  UserDirectory users;                ///< whose bearer tokens are accepted (everything but /v1/health)
   std::string pageTokenKey;           ///< signs page tokens (PageToken.hpp)
+  std::filesystem::path tlsCertificate;  ///< PEM chain: the listener speaks HTTPS when set (with tlsKey)
+  std::filesystem::path tlsKey;          ///< PEM private key of tlsCertificate
   int workers = 1;                    ///< concurrent solver processes (0: jobs stay QUEUED)
   int workerNice = 10;                ///< solvers run this much nicer than the server [0, 19]
   std::filesystem::path solverPath;   ///< the rcfd-solve executable

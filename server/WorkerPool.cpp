@@ -203,7 +203,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
   }
   if (setupError.empty()) {
     const std::string header = "=== attempt " + std::to_string(job.attempt + 1) + " at " +
-                               nowRfc3339() + " ===\n";
+                               nowRfc3339() + " of " + job.owner + "'s job ===\n";
     (void)!::write(logFd, header.data(), header.size());
     logStart += static_cast<std::streamoff>(header.size());
     const std::string solver = config_.solverPath.string();

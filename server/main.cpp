@@ -26,6 +26,8 @@
 #include "PageToken.hpp"
 #include "Router.hpp"
 #include "ServerConfig.hpp"
+#include "TlsContext.hpp"
+#include "Users.hpp"
 #include "WorkerPool.hpp"
 
 namespace net = boost::asio;
@@ -115,7 +117,7 @@ int main(int argc, char** argv) {
   if (argc == 3 && std::string_view(argv[1]) == kCheckDatabaseArgument) return checkUploadedDatabase(argv[2]);
   CLI::App app{"rcfd-server: the rcfd job server (REST under /v1, docs/api.md)"};
   ServerConfig config;
-  std::string dataDir, listen = "127.0.0.1:8080", tokenFile, solver;
+  std::string dataDir, listen = "127.0.0.1:8080", tokenFile, usersFile, tlsCert, tlsKey, solver;
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   config.workers = static_cast<int>(std::max(1u, cores / 2));
   int ioThreads = 2;
@@ -123,7 +125,16 @@ int main(int argc, char** argv) {
   int graceSeconds = static_cast<int>(config.shutdownGrace.count());
   app.add_option("--data-dir", dataDir, "directory for rcfd.sqlite, jobs/ and databases/")->required();
   app.add_option("--listen", listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
-  app.add_option("--token-file", tokenFile, "file holding the bearer token (else RCFD_TOKEN, else DIR/token)");
+  auto* tokenOption =
+      app.add_option("--token-file", tokenFile, "file holding the bearer token (else RCFD_TOKEN, else DIR/token)");
+  app.add_option("--users-file", usersFile,
+                 "named users instead of one token: lines NAME ROLE SHA256HEX (ROLE user or admin; the "
+                 "SHA-256 of the user's token: printf %s TOKEN | sha256sum)")
+      ->excludes(tokenOption);
+  auto* certOption = app.add_option("--tls-cert", tlsCert, "PEM certificate chain: the server speaks HTTPS");
+  auto* keyOption = app.add_option("--tls-key", tlsKey, "PEM private key of --tls-cert (unencrypted)");
+  certOption->needs(keyOption);
+  keyOption->needs(certOption);
   app.add_option("--workers", config.workers, "concurrent solver processes; 0 keeps jobs queued")->capture_default_str()
       ->check(CLI::Range(0, 1024));
   app.add_option("--worker-nice", config.workerNice,
@@ -165,7 +176,20 @@ int main(int argc, char** argv) {
     warnIfOpenToOthers(config.dataDir);
     std::filesystem::create_directories(config.dataDir / "jobs");
     std::filesystem::create_directories(config.databaseDir());
-    config.token = resolveToken(tokenFile, config.dataDir);
+    if (usersFile.empty()) {
+      config.users = UserDirectory::singleToken(resolveToken(tokenFile, config.dataDir));
+    } else {
+      std::string warning;
+      config.users = UserDirectory::load(usersFile, warning);
+      if (!warning.empty()) std::cerr << "rcfd-server: warning: " << warning << "\n";
+      std::cerr << "rcfd-server: " << config.users.size() << " user(s) from " << usersFile << "\n";
+    }
+    std::unique_ptr<net::ssl::context> tls;
+    if (!tlsCert.empty()) {
+      std::string warning;
+      tls = serverTlsContext(tlsCert, tlsKey, warning);
+      if (!warning.empty()) std::cerr << "rcfd-server: warning: " << warning << "\n";
+    }
     config.pageTokenKey = pageTokenKey(config.dataDir);
     config.solverPath = solver.empty() ? defaultSolver() : std::filesystem::absolute(solver);
     config.jsonBodyLimit = maxBody;
@@ -188,7 +212,7 @@ int main(int argc, char** argv) {
     Router router(store, pool, metrics, config);
     net::io_context ioc(ioThreads);
     net::thread_pool blocking(2);
-    auto listener = std::make_shared<Listener>(ioc, parseListen(listen), router, blocking);
+    auto listener = std::make_shared<Listener>(ioc, parseListen(listen), router, blocking, tls.get());
     // Signals are caught before the listening line is printed, so a supervisor that reads it can
     // always stop the server gracefully.
     // Shutdown: refuse new connections, keep answering the open ones (status polls see the jobs
@@ -208,7 +232,7 @@ int main(int argc, char** argv) {
     const auto bound = listener->endpoint();
     const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]"
                                                      : bound.address().to_string();
-    std::cout << "listening on http://" << host << ":" << bound.port() << std::endl;
+    std::cout << "listening on " << (tls ? "https" : "http") << "://" << host << ":" << bound.port() << std::endl;
     std::cerr << "rcfd-server: data " << config.dataDir.string() << ", " << config.workers
               << " worker slot(s), solver " << config.solverPath.string() << "\n";
     pool.start();

@@ -69,6 +69,41 @@ void File::createGroup(const std::string& group) {
   }
 }
 
+std::vector<std::string> File::children(const std::string& group) const {
+  std::vector<std::string> names;
+#if H5_VERSION_GE(1, 12, 0)
+  using LinkInfo = H5L_info2_t;
+#define RCFD_H5_ITERATE H5Literate_by_name2
+#else
+  using LinkInfo = H5L_info_t;
+#define RCFD_H5_ITERATE H5Literate_by_name
+#endif
+  auto collect = [](hid_t, const char* name, const LinkInfo*, void* data) -> herr_t {
+    static_cast<std::vector<std::string>*>(data)->push_back(name);
+    return 0;
+  };
+  hsize_t index = 0;
+  check(RCFD_H5_ITERATE(file_.id(), group.c_str(), H5_INDEX_NAME, H5_ITER_INC, &index, collect, &names,
+                        H5P_DEFAULT),
+        "list " + group + " in " + path_);
+#undef RCFD_H5_ITERATE
+  return names;
+}
+
+void File::copyFrom(const File& from, const std::string& source, const std::string& target) {
+  const auto slash = target.rfind('/');
+  if (slash != std::string::npos && slash > 0) createGroup(target.substr(0, slash));
+  check(H5Ocopy(from.id(), source.c_str(), file_.id(), target.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+        "copy " + from.path() + ":" + source + " to " + path_ + ":" + target);
+}
+
+void File::hardLink(const std::string& source, const std::string& target) {
+  const auto slash = target.rfind('/');
+  if (slash != std::string::npos && slash > 0) createGroup(target.substr(0, slash));
+  check(H5Lcreate_hard(file_.id(), source.c_str(), file_.id(), target.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+        "link " + target + " to " + source + " in " + path_);
+}
+
 void File::writeTyped(const std::string& name, hid_t type, const void* data, std::size_t n,
                       const std::vector<hsize_t>& shape) {
   std::vector<hsize_t> dims = shape.empty() ? std::vector<hsize_t>{hsize_t(n)} : shape;

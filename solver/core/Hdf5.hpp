@@ -41,6 +41,12 @@ class File {
   bool exists(const std::string& object) const;
   /// Creates the group and its parents if missing.
   void createGroup(const std::string& group);
+  /// Names of the links directly in `group`, in name order.
+  std::vector<std::string> children(const std::string& group) const;
+  /// Copies object `source` of `from` (a dataset, or a group with everything in it) to `target` here.
+  void copyFrom(const File& from, const std::string& source, const std::string& target);
+  /// A second name `target` for the object `source` of this file (a hard link: no data is copied).
+  void hardLink(const std::string& source, const std::string& target);
 
   void write(const std::string& name, const std::vector<double>& data,
              const std::vector<hsize_t>& shape = {});

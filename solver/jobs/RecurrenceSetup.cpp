@@ -49,10 +49,19 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
     throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));
   }
   if (stopRequested && stopRequested()) throw Cancelled("stopped before building the recurrence path");
-  auto generator = PathGeneratorRegistry::create(scene.rcfd.path.type, scene.rcfd.path);
-  setup.path = generator->generate(setup.matrix.R, frames, seed);
-  setup.pathStats = pathStatistics(setup.path, setup.matrix.R);
+  setup.path = generateRecurrencePath(scene, setup.matrix, frames, seed, &setup.pathStats);
   return setup;
+}
+
+RecurrencePath generateRecurrencePath(const Scene& scene, const RecurrenceMatrix& matrix, std::int64_t frames,
+                                      std::uint64_t seed, PathStatistics* statistics) {
+  if (!PathGeneratorRegistry::contains(scene.rcfd.path.type)) {
+    throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));
+  }
+  auto generator = PathGeneratorRegistry::create(scene.rcfd.path.type, scene.rcfd.path);
+  RecurrencePath path = generator->generate(matrix.R, frames, seed);
+  if (statistics) *statistics = pathStatistics(path, matrix.R);
+  return path;
 }
 
 }  // namespace rcfd

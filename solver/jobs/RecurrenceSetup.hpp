@@ -28,4 +28,10 @@ struct RecurrenceSetup {
 RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databasePath, std::int64_t frames,
                                   std::uint64_t seed, const std::function<bool()>& stopRequested = {});
 
+/// The path of the scene's generator through `matrix`, of at least `frames` entries, for `seed`, and
+/// its statistics: what prepareRecurrence builds for its seed (an ensemble's further members draw
+/// theirs with it from the one matrix). InputError for an unknown generator.
+RecurrencePath generateRecurrencePath(const Scene& scene, const RecurrenceMatrix& matrix, std::int64_t frames,
+                                      std::uint64_t seed, PathStatistics* statistics = nullptr);
+
 }  // namespace rcfd

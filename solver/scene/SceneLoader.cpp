@@ -113,6 +113,9 @@ JobSpec loadJob(const json& document, const std::string& source, const std::stri
   job.checkpoint_interval = document.value("checkpoint_interval", job.checkpoint_interval);
   job.d0_values = document.value("d0_values", job.d0_values);
   job.discard = document.value("discard", job.discard);
+  if (const auto e = document.find("ensemble"); e != document.end()) {  // K, or {"members": K}
+    job.ensemble_members = e->is_object() ? e->at("members").get<int>() : e->get<int>();
+  }
 
   // A /scene_patch (RFC 7396 merge patch) changes the scene for this job only; the patched scene is
   // validated as a whole, and its errors name the scene's pointers and where the scene came from.

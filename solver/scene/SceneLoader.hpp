@@ -24,6 +24,7 @@ struct JobSpec {
   double checkpoint_interval = 60.0;  ///< simulated seconds between checkpoints [s]
   std::vector<double> d0_values;      ///< calibration [m2/s]
   double discard = 5.0;               ///< calibration: ignored start [s]
+  int ensemble_members = 1;           ///< spray: realisations K in [1, 64] (`ensemble`; 1: a plain run)
   nlohmann::json source;              ///< the job document as given
 };
 

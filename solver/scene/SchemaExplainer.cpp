@@ -219,12 +219,21 @@ void SchemaExplainer::check(const json& schemaIn, const Context& ctxIn, const js
         {"maximum", "<=", [](double x, double b) { return x <= b; }},
         {"exclusiveMaximum", "<", [](double x, double b) { return x < b; }},
     };
+    // A value bounded on both sides is told the whole range, e.g. "; allowed: [1, 64]".
+    std::string range;
+    const auto lower = schema.contains("minimum") ? schema.find("minimum") : schema.find("exclusiveMinimum");
+    const auto upper = schema.contains("maximum") ? schema.find("maximum") : schema.find("exclusiveMaximum");
+    if (lower != schema.end() && upper != schema.end() && lower->is_number() && upper->is_number()) {
+      range = std::string("; allowed: ") + (schema.contains("minimum") ? "[" : "(") +
+              formatNumber(lower->get<double>()) + ", " + formatNumber(upper->get<double>()) +
+              (schema.contains("maximum") ? "]" : ")");
+    }
     for (const auto& b : bounds) {
       auto it = schema.find(b.keyword);
       if (it == schema.end() || !it->is_number()) continue;
       if (!b.ok(v, it->get<double>())) {
         out.push_back({pointer, shown + " is not " + b.relation + " " + formatNumber(it->get<double>()) +
-                                    " (" + b.keyword + ")"});
+                                    " (" + b.keyword + ")" + range});
       }
     }
   }

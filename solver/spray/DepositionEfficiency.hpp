@@ -30,8 +30,9 @@ struct DepositionConstants {
   double gasViscosity = 1.5e-5;      ///< nu_G [m2/s]
 };
 
-/// Largest alpha_P the correlation is evaluated at (random close packing); denser cells (tracer
-/// over-packing) use this value. A's denominator is positive up to it (Eq. 14).
+/// Largest alpha_P the correlation is evaluated at: the densest packing of equal spheres (FCC/HCP,
+/// pi / (3 sqrt 2) = 0.7405; random close packing is about 0.64); denser cells (tracer over-packing)
+/// use this value. A's denominator is positive up to it (Eq. 14).
 inline constexpr double kMaxPackingForDeposition = 0.74;
 
 /// Eq. (14): Happel's parameter A(alpha_P), for alpha_P in [0, kMaxPackingForDeposition].

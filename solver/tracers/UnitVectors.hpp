@@ -59,7 +59,6 @@ inline void counterDirectionBits(const CounterRngPrefix& prefix, std::uint64_t s
 /// counterDirectionBits(): z = 2 u1 - 1 and the azimuth 2 pi u2 with u = bits / 2^24. The motion
 /// kernel's Eq. (10) direction: its speed is a float per cell already, so a direction to float
 /// precision (|n| = 1 within 3e-7) loses nothing, and float halves the vector work of the double form.
-/// (Until 2026-12-02 the bits came from SplitMix64, CounterRng's first draw: 2x the cost on AVX2.)
 inline void counterUnitVectorFloat(const CounterRngPrefix& prefix, std::uint64_t stream, float& x, float& y, float& z) {
   std::uint32_t zBits, azimuthBits;
   counterDirectionBits(prefix, stream, zBits, azimuthBits);

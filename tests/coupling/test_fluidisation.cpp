@@ -58,7 +58,7 @@ struct FluidisationRun {
   double ergunUmf = 0.0;  ///< Ergun's U_mf at the defluidised bed's own porosity [m/s]
 };
 
-// A 5 cm x 5 cm box (14 parcel diameters), cg 2 parcels of 3.6 mm in 5 mm cells (quick.json's until 2026-12-02), a
+// A 5 cm x 5 cm box (14 parcel diameters), cg 2 parcels of 3.6 mm in 5 mm cells, a
 // bed of 1570 parcels poured and settled (DEM only, as in the database job), about 2.6 cm high. The
 // gas rises to 0.9 m/s (1.6 Wen-Yu) in 0.2 s, stays 0.15 s (the bed slugs), and falls to 0.2 m/s in
 // 0.7 s (1 m/s^2: halving the rate moves U_mf by 1-3%, docs/physics.md). The packed-bed branch is the

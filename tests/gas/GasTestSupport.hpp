@@ -7,8 +7,8 @@
 
 namespace rcfd::test {
 
-/// The quick slice of examples/quick.json on its former 5 mm cells (quick.json has 6.67 mm since
-/// 2026-12-02; these tests keep the finer grid they were written for): 0.02 m deep, 1/10 of the paper's flows.
+/// The quick slice of examples/quick.json on 5 mm cells (quick.json has 6.67 mm; these tests keep the
+/// finer grid their tolerances were set on): 0.02 m deep, 1/10 of the paper's flows.
 inline Scene quickSliceScene(bool plates) {
   Scene s;
   s.apparatus.depth = 0.02;

@@ -338,6 +338,38 @@ TEST_F(CancelTracerRuns, OfASprayJobCheckpointsAndTheSameCommandResumes) {
   expectCancelledWithin(resumed, "stopped in the run phase");
 }
 
+TEST_F(CancelTracerRuns, OfAnEnsembleCheckpointsEveryRunningMemberAndTheSameCommandResumes) {
+  writeJson(dir_ / "job.json", {{"kind", "spray"},
+                                {"scene", tracerScene(0.01, 2000)},
+                                {"database", (dir_ / "db.h5").string()},
+                                {"duration", 1000.0},
+                                {"seed", 5},
+                                {"checkpoint_interval", 1000.0},
+                                {"ensemble", 3}});
+  auto args = runArgs(dir_ / "job.json", dir_ / "out");
+  args.insert(args.end(), {"--threads", "2"});  // two members at a time
+  {
+    SolveChild solver(args, dir_ / "stderr.txt");
+    const json running = solver.waitForProgress(
+        [](const json& p) { return p.value("phase", "") == "run" && p.at("fraction") > 0.0; }, kPhaseTimeout);
+    ASSERT_FALSE(running.is_null()) << solver.stderrText();
+    expectCancelledWithin(solver, "ensemble stopped in the run phase");
+    EXPECT_TRUE(fs::exists(dir_ / "out" / "members" / "00" / "checkpoint.h5"));
+    EXPECT_TRUE(fs::exists(dir_ / "out" / "members" / "01" / "checkpoint.h5"));
+    EXPECT_FALSE(fs::exists(dir_ / "out" / "members" / "02"));
+  }
+  // The run phase starts from the members' checkpoints; each member logs "resumed at step N" before
+  // its first step, so by a report beyond the first every running member has.
+  SolveChild resumed(args, dir_ / "stderr-resumed.txt");
+  const json first = resumed.waitForPhase("run", kPhaseTimeout);
+  ASSERT_FALSE(first.is_null()) << resumed.stderrText();
+  EXPECT_GT(first.at("fraction").get<double>(), 0.0);
+  const double from = first.at("fraction");
+  ASSERT_FALSE(resumed.waitForProgress([&](const json& p) { return p.at("fraction") > from; }, kPhaseTimeout).is_null());
+  EXPECT_GT(resumedStep(resumed.stderrText()), 0) << resumed.stderrText();
+  expectCancelledWithin(resumed, "ensemble stopped in the run phase");
+}
+
 // --- the watchdog: the bound for the steps no phase can look inside ---
 
 // In a child process each (a death test): the watchdog ends the process it runs in.

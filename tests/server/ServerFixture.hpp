@@ -103,18 +103,19 @@ class ServerProcess {
  public:
   /// fileLimit > 0: the server runs with at most that many open descriptors (RLIMIT_NOFILE). `listen`
   /// is its address (port 0: any free port; a restart passes the port of the server it replaces).
+  /// An empty `token` passes no --token-file (for a server given --users-file in `extraArgs`); get()
+  /// and post() then send no token.
   ServerProcess(const std::filesystem::path& dataDir, std::string token,
                 std::vector<std::string> extraArgs = {"--workers", "0"}, int fileLimit = 0,
                 const std::string& listen = "127.0.0.1:0")
       : dataDir_(dataDir), token_(std::move(token)) {
     const auto binary = binaryDir() / "rcfd-server";
-    const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
-    {
-      std::ofstream out(tokenFile);
-      out << token_ << "\n";
+    std::vector<std::string> args = {binary.string(), "--data-dir", dataDir.string(), "--listen", listen};
+    if (!token_.empty()) {
+      const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
+      std::ofstream(tokenFile) << token_ << "\n";
+      args.insert(args.end(), {"--token-file", tokenFile.string()});
     }
-    std::vector<std::string> args = {binary.string(), "--data-dir", dataDir.string(), "--listen",
-                                     listen, "--token-file", tokenFile.string()};
     args.insert(args.end(), extraArgs.begin(), extraArgs.end());
     int out[2];
     if (::pipe(out) != 0) throw std::runtime_error("pipe");
@@ -136,15 +137,23 @@ class ServerProcess {
       ::_exit(127);
     }
     ::close(out[1]);
-    // First stdout line: "listening on http://127.0.0.1:PORT".
+    // First stdout line: "listening on http://127.0.0.1:PORT" (https:// with --tls-cert).
     std::string line;
     char c;
     while (::read(out[0], &c, 1) == 1 && c != '\n') line.push_back(c);
     ::close(out[0]);
     firstLine_ = line;
     const auto colon = line.rfind(':');
-    if (line.rfind("listening on http://", 0) != 0 || colon == std::string::npos)
+    tls_ = line.rfind("listening on https://", 0) == 0;
+    if ((!tls_ && line.rfind("listening on http://", 0) != 0) || colon == std::string::npos) {
+      // A server that refused to start has exited (one that printed something else is stopped): reap
+      // it; its last words are in its stderr file.
+      ::kill(pid_, SIGKILL);
+      int status = 0;
+      ::waitpid(pid_, &status, 0);
+      pid_ = -1;
       throw std::runtime_error("rcfd-server did not start: \"" + line + "\"; stderr: " + stderrText());
+    }
     port_ = static_cast<unsigned short>(std::stoi(line.substr(colon + 1)));
   }
   ~ServerProcess() {
@@ -168,7 +177,7 @@ class ServerProcess {
   pid_t pid() const { return pid_; }
   const std::string& token() const { return token_; }
   const std::string& firstLine() const { return firstLine_; }
-  std::string url() const { return "http://127.0.0.1:" + std::to_string(port_); }
+  std::string url() const { return (tls_ ? "https" : "http") + std::string("://127.0.0.1:") + std::to_string(port_); }
   std::string stderrText() const {
     std::ifstream in(stderrPath_);
     return std::string(std::istreambuf_iterator<char>(in), {});
@@ -187,6 +196,7 @@ class ServerProcess {
   std::string token_, firstLine_;
   pid_t pid_ = -1;
   unsigned short port_ = 0;
+  bool tls_ = false;
 };
 
 /// The scene of examples/quick.json (a scene, or a job file holding one inline or via scene_file).

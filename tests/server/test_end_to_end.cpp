@@ -308,7 +308,7 @@ TEST_F(EndToEnd, AKilledSolverIsRetriedFromItsCheckpointAutomaticallyAndOnReques
   for (const auto& e : events) {
     const std::string reason = e.at("reason");
     automatic += reason.find("automatic retry") != std::string::npos;
-    requested += reason.find("retry requested; resumes from its checkpoint") != std::string::npos;
+    requested += reason.find("retry requested by admin; resumes from its checkpoint") != std::string::npos;
   }
   EXPECT_EQ(automatic, 1) << events.dump(2);
   EXPECT_EQ(requested, 1) << events.dump(2);

@@ -1,6 +1,6 @@
 // The tracer and spray benchmarks (bench/) time the motion kernel and the spray on a synthetic field.
 // A field whose u_P^rec gathers the tracers into a few cells times a kernel that reads a few cells and
-// a spray that misses the bed, as the swaying spout did until 2026-12-03. These tests guard the
+// a spray that misses the bed, as the swaying spout does. These tests guard the
 // benchmark's case, bench/CirculatingBed.hpp.
 #include <gtest/gtest.h>
 
@@ -30,8 +30,8 @@ TEST(BenchmarkField, TheCirculatingBedKeepsItsTracersSpreadWhereTheSwayingSpoutG
   std::cerr << "circulating bed " << bed.dump() << "\nswaying spout " << spout.dump() << "\n";
   // alpha_P^rec is at most 0.45 + 2% noise. The tracers exceed it where the cell-centred field's
   // interpolation error gathers them, in small cut cells at the walls, and by counting noise (about 6
-  // tracers per cell here), but the median tracer sees about alpha_P^rec (2026-12-03: 0.38; the
-  // swaying spout 17).
+  // tracers per cell here), but the median tracer sees about alpha_P^rec (about 0.38; the swaying
+  // spout 17).
   EXPECT_LT(bed.at("tracer_alpha_p50").get<double>(), 0.6);
   EXPECT_LT(bed.at("tracers_over_alpha_1").get<double>(), 0.2);
   EXPECT_GT(spout.at("tracer_alpha_p50").get<double>(), 3.0);  // the checks can fail

@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# The paper's lab bed end to end (docs/paper-reproduction.md): for ProCell without and with draft
+# plates, the coarse-grained CFD-DEM database job (examples/jobs/VARIANT-database.json), the D0
+# calibration against its reference period (the paper's 35 s per D0, 5 s discarded), and one hour of
+# spray at the selected D0 with the scene's 472,850 tracers; then a table of what each gives.
+#   bash scripts/paper.sh OUT_DIR [VARIANT ...]
+# VARIANT: procell-coarse-grained (no plates) and procell-coarse-grained-draft-plates (default: both).
+# Resumable: run it again with the same OUT_DIR; finished jobs are kept, interrupted ones resume from
+# their checkpoints. A database job takes hours on 2 cores (docs/performance.md), so put OUT_DIR outside
+# the repository. RCFD_PAPER_SPRAY_S sets the spray duration (default 3600 s), RCFD_PAPER_STAGES the
+# stages to run (default "database calibration spray"). Progress goes to the terminal and to each
+# job's log in OUT_DIR. Needs a build and jq.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if [ $# -lt 1 ]; then
+  echo "usage: $0 OUT_DIR [VARIANT ...]" >&2
+  exit 2
+fi
+out=$(mkdir -p "$1" && cd "$1" && pwd)
+shift
+variants=("$@")
+[ ${#variants[@]} -gt 0 ] || variants=(procell-coarse-grained procell-coarse-grained-draft-plates)
+spray_s=${RCFD_PAPER_SPRAY_S:-3600}
+stages=${RCFD_PAPER_STAGES:-database calibration spray}
+solve=$(pwd)/build/rcfd-solve
+command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
+[ -x "$solve" ] || { echo "$0: no build; run scripts/build.sh" >&2; exit 2; }
+
+wants() { [[ " $stages " == *" $1 "* ]]; }
+
+# Runs one job resumably: skipped when DIR/summary.json exists, else run (or resumed) with its progress
+# lines on the terminal and everything in DIR.log.
+run_job() {
+  local name=$1 job=$2 dir=$3
+  if [ -f "$dir/summary.json" ]; then
+    echo "== $name: done ($dir/summary.json)"
+    return
+  fi
+  echo "== $name (log $dir.log)"
+  "$solve" run "$job" --out "$dir" 2>&1 | tee -a "$dir.log" | grep --line-buffered -E '%|done|error|cancelled' |
+    awk -v n="$name" '{ if (/%/) { if (NR % 20 == 1) print "   " n ": " $0 } else print "   " n ": " $0; fflush() }'
+  [ -f "$dir/summary.json" ] || { echo "$0: $name did not finish; see $dir.log" >&2; exit 1; }
+}
+
+for v in "${variants[@]}"; do
+  example=$(pwd)/examples/jobs/$v-database.json
+  [ -f "$example" ] || { echo "$0: no $example" >&2; exit 2; }
+  # The example's scene file and patch, resolved against examples/jobs/ so the jobs run from OUT_DIR.
+  scene=$(cd "$(dirname "$example")" && cd "$(dirname "$(jq -r '.scene_file' "$example")")" && pwd)/$(basename "$(jq -r '.scene_file' "$example")")
+  patch=$(jq '.scene_patch // {}' "$example")
+  jq --arg scene "$scene" '.scene_file = $scene' "$example" > "$out/db-$v.json"
+  wants database && run_job "$v database" "$out/db-$v.json" "$out/db-$v"
+  [ -f "$out/db-$v/summary.json" ] || continue
+
+  jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" \
+    '{kind: "calibration", scene_file: $scene, scene_patch: $patch, database: $db, duration: 35.0,
+      discard: 5.0, seed: 1, checkpoint_interval: 5.0}' > "$out/cal-$v.json"
+  wants calibration && run_job "$v calibration" "$out/cal-$v.json" "$out/cal-$v"
+  [ -f "$out/cal-$v/summary.json" ] || continue
+
+  d0=$(jq '.selected_d0' "$out/cal-$v/summary.json")
+  jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" --argjson d0 "$d0" \
+    --argjson t "$spray_s" \
+    '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: {d0: $d0}}), database: $db,
+      duration: $t, seed: 1, checkpoint_interval: 300.0}' > "$out/spray-$v.json"
+  wants spray && run_job "$v spray" "$out/spray-$v.json" "$out/spray-$v"
+done
+
+# One row per variant: the calibration's scores at the selected D0 and the coating after the spray.
+echo
+printf '%-38s %-9s %-8s %-9s %-8s %-7s %-9s %-8s %-8s %-8s %-8s %s\n' variant D0 holdup mean_stay crossing KS \
+  overspray mean median p10 p90 'wall s (db/cal/spray)'
+for v in "${variants[@]}"; do
+  cal=$out/cal-$v/summary.json spray=$out/spray-$v/summary.json db=$out/db-$v/summary.json
+  [ -f "$cal" ] || continue
+  scores=$(jq -r '.selected_d0 as $d | (.d0[] | select(.value == $d)) as $r |
+    def pct: if . == null then "n/a" else (. * 1000 | round / 10 | tostring) + "%" end;
+    [($d | tostring), ($r.holdup_relative_error | pct), ($r.residence_time_mean_relative_error | pct),
+     ($r.crossing_rate_relative_error | pct),
+     (if $r.rtd_ks_distance == null then "n/a" else ($r.rtd_ks_distance * 1000 | round / 1000 | tostring) end)] | @tsv' "$cal")
+  coating="n/a	n/a	n/a	n/a	n/a"
+  [ -f "$spray" ] && coating=$(jq -r '[.overspray_fraction, .coverage.mean, .coverage.median, .coverage.p10, .coverage.p90] |
+    map(. * 1000 | round / 1000 | tostring) | @tsv' "$spray")
+  walls=$(for f in "$db" "$cal" "$spray"; do [ -f "$f" ] && jq -r '.wall_time_s | round' "$f" || echo -; done | paste -sd/)
+  printf '%s\t%s\t%s\t%s\n' "$v" "$scores" "$coating" "$walls" |
+    awk -F'\t' '{printf "%-38s %-9s %-8s %-9s %-8s %-7s %-9s %-8s %-8s %-8s %-8s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12}'
+done
+echo "(holdup, mean stay, crossing rate against the database's reference period; KS of the stays; coverage after the spray)"

@@ -1,0 +1,77 @@
+#pragma once
+// Runs the `rcfd` client (build/rcfd) as a child process with its stdout and stderr captured: the
+// client as users run it, against a ServerProcess.
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ServerFixture.hpp"
+
+namespace rcfd::test {
+
+struct Run {
+  int code = -1;
+  std::string out, err;
+};
+
+/// build/rcfd running in the background with its stdout and stderr captured.
+struct RunningClient {
+  pid_t pid = -1;
+  std::unique_ptr<TempDir> capture = std::make_unique<TempDir>();
+  std::filesystem::path outPath() const { return capture->path() / "out"; }
+  std::filesystem::path errPath() const { return capture->path() / "err"; }
+  /// Waits for it to exit.
+  Run finish() {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    Run r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream o(outPath()), e(errPath());
+    r.out.assign(std::istreambuf_iterator<char>(o), {});
+    r.err.assign(std::istreambuf_iterator<char>(e), {});
+    return r;
+  }
+};
+
+/// Starts build/rcfd with arguments and extra environment.
+inline RunningClient startClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
+  const auto bin = (binaryDir() / "rcfd").string();
+  args.insert(args.begin(), bin);
+  RunningClient running;
+  const auto outPath = running.outPath(), errPath = running.errPath();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::alarm(60);  // a client that hangs is killed (and its test fails) instead of hanging the suite
+    ::unsetenv("RCFD_SERVER");
+    ::unsetenv("RCFD_TOKEN");
+    ::unsetenv("RCFD_CACERT");
+    for (const auto& e : env) ::putenv(const_cast<char*>(e.c_str()));
+    const int out = ::open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, 1);
+    ::dup2(err, 2);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  running.pid = pid;
+  return running;
+}
+
+/// Runs build/rcfd with arguments and extra environment; captures stdout and stderr.
+inline Run runClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
+  return startClient(std::move(args), env).finish();
+}
+
+inline std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
+
+}  // namespace rcfd::test
