@@ -160,38 +160,38 @@ inline void checkRange(const std::vector<double>& values, double lo, double hi, 
   }
 }
 
-/// The outputs of a finished tracer run (a spray job, or one D0 run of a calibration): tracers all
-/// there and inside the apparatus, coverage in [0, 1], the spray's books closed, counts >= 0.
-inline void checkTracerRun(const fs::path& dir, const Scene& scene, std::vector<std::string>& out) {
-  const json s = json::parse(std::ifstream(dir / "summary.json"));
-  findNulls(s, "", out);
-  checkFiniteDatasets(dir / "result.h5", {}, out);
-  if (!out.empty()) return;
-  h5::File r((dir / "result.h5").string(), h5::File::Mode::ReadOnly);
-  const auto x = r.readDoubles("/tracers/x"), y = r.readDoubles("/tracers/y"), z = r.readDoubles("/tracers/z");
+/// One tracer run's summary `s` and its result tree in `r` below `at` ("" for the file's root, an
+/// ensemble member's group otherwise): tracers all there and inside the apparatus, coverage in [0, 1],
+/// the spray's books closed, counts >= 0.
+inline void checkTracerResults(const json& s, const h5::File& r, const std::string& at, const Scene& scene,
+                               std::vector<std::string>& out) {
+  const std::string where = at.empty() ? std::string() : at + ": ";
+  const auto x = r.readDoubles(at + "/tracers/x"), y = r.readDoubles(at + "/tracers/y"),
+             z = r.readDoubles(at + "/tracers/z");
   if (std::int64_t(x.size()) != scene.rcfd.tracers || y.size() != x.size() || z.size() != x.size()) {
-    out.push_back("result.h5 holds " + std::to_string(x.size()) + " tracers, the scene " +
+    out.push_back("result.h5" + at + " holds " + std::to_string(x.size()) + " tracers, the scene " +
                   std::to_string(scene.rcfd.tracers));
     return;
   }
-  if (s.value("tracers", std::int64_t(-1)) != scene.rcfd.tracers) out.push_back("summary.json/tracers is not the scene's count");
+  if (s.value("tracers", std::int64_t(-1)) != scene.rcfd.tracers) out.push_back(where + "summary.json/tracers is not the scene's count");
   const Apparatus apparatus(scene.apparatus);
   // The kernel keeps tracers inside up to the wall test's tolerance band (docs/physics.md).
   const double tolerance = 4.0 * apparatus.boundaryTolerance();
   for (std::size_t i = 0; i < x.size(); ++i) {
     const double d = apparatus.signedDistance({x[i], y[i], z[i]});
     if (!(d >= -tolerance)) {
-      out.push_back("tracer " + std::to_string(i) + " at (" + std::to_string(x[i]) + ", " + std::to_string(y[i]) + ", " +
+      out.push_back(where + "tracer " + std::to_string(i) + " at (" + std::to_string(x[i]) + ", " + std::to_string(y[i]) + ", " +
                     std::to_string(z[i]) + ") is outside the apparatus (signed distance " + std::to_string(d) + " m)");
       break;
     }
   }
-  if (r.exists("/coverage/per_tracer")) {
-    checkRange(r.readDoubles("/coverage/per_tracer"), 0.0, 1.0, "/coverage/per_tracer", out);
-    checkRange(r.readDoubles("/coverage/droplets_per_particle"), 0.0, INFINITY, "/coverage/droplets_per_particle", out);
+  if (r.exists(at + "/coverage/per_tracer")) {
+    checkRange(r.readDoubles(at + "/coverage/per_tracer"), 0.0, 1.0, at + "/coverage/per_tracer", out);
+    checkRange(r.readDoubles(at + "/coverage/droplets_per_particle"), 0.0, INFINITY,
+               at + "/coverage/droplets_per_particle", out);
     for (const char* k : {"mean", "median", "p10", "p90"}) {
       const double v = s["coverage"][k].get<double>();
-      if (!(v >= 0.0 && v <= 1.0)) out.push_back(std::string("summary.json/coverage/") + k + " is outside [0, 1]");
+      if (!(v >= 0.0 && v <= 1.0)) out.push_back(where + "summary.json/coverage/" + k + " is outside [0, 1]");
     }
   }
   if (s.contains("mass_balance")) {
@@ -199,23 +199,63 @@ inline void checkTracerRun(const fs::path& dir, const Scene& scene, std::vector<
     const double injected = m["injected_kg"].get<double>();
     for (const char* k : {"injected_kg", "deposited_kg", "airborne_kg", "overspray_kg", "residual_kg", "on_tracers_kg",
                           "pending_in_cells_kg"}) {
-      if (!(m[k].get<double>() >= 0.0)) out.push_back(std::string("summary.json/mass_balance/") + k + " is negative");
+      if (!(m[k].get<double>() >= 0.0)) out.push_back(where + "summary.json/mass_balance/" + k + " is negative");
     }
     const double closure = m["closure_error_kg"].get<double>();
     if (!(std::abs(closure) <= 1e-9 * injected + 1e-300)) {
-      out.push_back("the spray's mass balance does not close: closure error " + std::to_string(closure) + " kg of " +
+      out.push_back(where + "the spray's mass balance does not close: closure error " + std::to_string(closure) + " kg of " +
                     std::to_string(injected) + " kg injected");
     }
     // What the tracers hold plus what waits in cells is what was deposited.
     const double held = m["on_tracers_kg"].get<double>() + m["pending_in_cells_kg"].get<double>();
     if (!(std::abs(held - m["deposited_kg"].get<double>()) <= 1e-9 * injected + 1e-300)) {
-      out.push_back("deposited mass " + std::to_string(m["deposited_kg"].get<double>()) +
+      out.push_back(where + "deposited mass " + std::to_string(m["deposited_kg"].get<double>()) +
                     " kg is not what the tracers and cells hold, " + std::to_string(held) + " kg");
     }
     const double f = s["overspray_fraction"].get<double>();
-    if (!(f >= 0.0 && f <= 1.0 + 1e-12)) out.push_back("summary.json/overspray_fraction is outside [0, 1]");
+    if (!(f >= 0.0 && f <= 1.0 + 1e-12)) out.push_back(where + "summary.json/overspray_fraction is outside [0, 1]");
   }
-  if (r.exists("/holdup/particles")) checkRange(r.readDoubles("/holdup/particles"), 0.0, INFINITY, "/holdup/particles", out);
+  if (r.exists(at + "/holdup/particles")) {
+    checkRange(r.readDoubles(at + "/holdup/particles"), 0.0, INFINITY, at + "/holdup/particles", out);
+  }
+}
+
+/// The outputs of a finished tracer run (a spray job, or one D0 run of a calibration), checked by
+/// checkTracerResults; an ensemble's members each the same way, the K members of the job with K
+/// distinct seeds (docs/formats.md, "Ensembles").
+inline void checkTracerRun(const fs::path& dir, const Scene& scene, std::vector<std::string>& out,
+                           int ensembleMembers = 1) {
+  const json s = json::parse(std::ifstream(dir / "summary.json"));
+  findNulls(s, "", out);
+  checkFiniteDatasets(dir / "result.h5", {}, out);
+  if (!out.empty()) return;
+  const h5::File r((dir / "result.h5").string(), h5::File::Mode::ReadOnly);
+  checkTracerResults(s, r, "", scene, out);
+  if (ensembleMembers == 1) {
+    if (s.contains("ensemble") || r.exists("/ensemble")) out.push_back("a run of one member writes an ensemble block");
+    return;
+  }
+  if (!s.contains("ensemble") || !r.exists("/ensemble/members")) {
+    out.push_back("an ensemble of " + std::to_string(ensembleMembers) + " writes no ensemble block");
+    return;
+  }
+  const auto members = r.children("/ensemble/members");
+  const auto seeds = r.readInt64s("/ensemble/seeds");
+  if (int(members.size()) != ensembleMembers || r.intAttribute("/ensemble", "members") != ensembleMembers ||
+      s["ensemble"]["members"].get<int>() != ensembleMembers || int(seeds.size()) != ensembleMembers) {
+    out.push_back("an ensemble of " + std::to_string(ensembleMembers) + " holds " + std::to_string(members.size()) +
+                  " members and " + std::to_string(seeds.size()) + " seeds");
+    return;
+  }
+  if (std::set<std::int64_t>(seeds.begin(), seeds.end()).size() != seeds.size()) out.push_back("two members share a seed");
+  for (const auto& m : members) {
+    const std::string at = "/ensemble/members/" + m;
+    const json ms = json::parse(r.readString(at + "/summary"));
+    std::vector<std::string> member;
+    findNulls(ms, "", member);
+    if (member.empty()) checkTracerResults(ms, r, at, scene, member);
+    for (auto& p : member) out.push_back("member " + m + ": " + p);
+  }
 }
 
 /// The outputs of a finished database job: database.h5 passes the reader's validation, every frame's
@@ -300,7 +340,7 @@ inline std::string outcomeProblem(const Outcome& o, const json& job, const fs::p
   try {
     const JobSpec spec = loadJob(job, "job", dir.string());
     const fs::path out = dir / "out";
-    if (spec.kind == "spray") checkTracerRun(out, spec.scene, problems);
+    if (spec.kind == "spray") checkTracerRun(out, spec.scene, problems, spec.ensemble_members);
     if (spec.kind == "database") checkDatabaseJob(out, spec.scene, problems);
     if (spec.kind == "calibration") checkCalibrationJob(out, spec.scene, problems);
   } catch (const std::exception& e) {

@@ -57,8 +57,10 @@ class JobGenerator {
                         {"svg", chance(0.15)}};
     if (kind_ == "database") {
       scene["effects"] = databaseEffects();
-      return {{"kind", "database"}, {"scene", scene}, {"seed", integer(0, 1000000)},
-              {"checkpoint_interval", logUniform(0.005, 1.0)}};
+      json job = {{"kind", "database"}, {"scene", scene}, {"seed", integer(0, 1000000)},
+                  {"checkpoint_interval", logUniform(0.005, 1.0)}};
+      if (chance(0.01)) job["ensemble"] = 2;  // 1 %: an ensemble outside a spray job (refused)
+      return job;
     }
     scene["effects"] = tracerEffects();
     const double dtRec = logUniform(1e-3, 0.05);
@@ -78,6 +80,12 @@ class JobGenerator {
       for (long i = 0; i < n; ++i) d0.push_back(chance(0.2) ? 0.0 : logUniform(1e-7, 0.05) * double(i + 1));
       job["d0_values"] = d0;
       job["discard"] = double(integer(0, steps - 1)) * dt;
+    }
+    // Drawn last, so that no other draw of a seed depends on it. Spray jobs: 10 % an ensemble of 1 to 3
+    // members in either form; calibrations: 1 % one (refused).
+    if (chance(kind_ == "spray" ? 0.1 : 0.01)) {
+      const long members = kind_ == "spray" ? integer(1, 3) : 2;
+      job["ensemble"] = chance(0.5) ? json(members) : json{{"members", members}};
     }
     return job;
   }
