@@ -4,6 +4,7 @@
 // BoxWalls.RandomBarrageAt20Metres... and ApparatusAdaptor.ImpactsAt20Metres... (tests/dem, tests/coupling).
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <spdlog/spdlog.h>
 
@@ -81,11 +82,13 @@ TEST(CfdDemCases, OverlappingParcelsSeparateWithoutBlowingUp) {
         ASSERT_TRUE(p.x[i].allFinite() && p.v[i].allFinite()) << "step " << k;
         ASSERT_TRUE((p.x[i].array() > 0.0).all() && (p.x[i].array() < 0.04).all()) << "step " << k << " parcel " << i;
       }
-      Vector3d first, second;  // the pair, by identity (the DEM sorts its parcels)
+      // The pair, by identity (the DEM sorts its parcels); NaN until found.
+      Vector3d first = Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()), second = first;
       for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.id[i] == 0) first = p.x[i];
         if (p.id[i] == 1) second = p.x[i];
       }
+      ASSERT_TRUE(first.allFinite() && second.allFinite()) << "step " << k << ": parcel 0 or 1 is gone";
       if (separatedAt < 0 && (first - second).norm() > 2.0 * r) separatedAt = k;
       ASSERT_LE(dem.totalEnergy(), stored * (1.0 + 1e-6)) << "step " << k;
     }
