@@ -6,7 +6,7 @@
 ///
 ///   // in FluctuationModel.hpp
 ///   using FluctuationModelRegistry = Registry<FluctuationModel, const Scene&>;
-///   // in LichteneggerPirkerFluctuation.cpp
+///   // in FluctuationModels.cpp
 ///   static const bool registered = FluctuationModelRegistry::add(
 ///       "lichtenegger_pirker", "Eq. (10): n sqrt(D0 dalpha / (6 pi dt alpha_P))",
 ///       [](const Scene& s) { return std::make_unique<LichteneggerPirkerFluctuation>(s); });

@@ -56,7 +56,7 @@ class SprayEffect final : public TracerEffect {
     const double m = s.dropletMass;
     const double airborne = s.airborne();
     const double overspray = b.oversprayWall + b.oversprayOutlet;
-    // residual: parcels removed with fewer than one droplet left (the and CONTRACTS.md's term);
+    // residual: parcels removed with fewer than one droplet left (docs/contracts.md, "Mass balance");
     // closure_error: what the books fail to account for (round-off only).
     const double closure = b.injected - (b.deposited + airborne + overspray + b.residual);
     double pending = 0.0;
