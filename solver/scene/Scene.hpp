@@ -56,7 +56,8 @@ struct GasSpec {
   double max_time_step = 2.5e-5;         ///< upper bound of dt_CFD [s]
   double pressure_tolerance = 1e-8;      ///< relative residual of the pressure solver [-]
   double smoothing_length = 5.4e-3;      ///< L_smooth of Eq. (3), about three particle diameters [m]
-  /// Drag law F(eps, Re) of the coupling, a name of coupling::DragModelRegistry ("beetstra").
+  /// Drag law F(eps, Re) of the coupling, a name of coupling::DragModelRegistry ("beetstra",
+  /// "gidaspow", "wen_yu").
   std::string drag_model = "beetstra";
 };
 
