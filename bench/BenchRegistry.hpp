@@ -3,9 +3,9 @@
 /// rcfd-bench NAME [--quick] [--json] [--threads N]: each bench/*.cpp registers one named benchmark.
 /// A benchmark prints human-readable lines as it goes and returns its figures as a JSON object; with
 /// --json, main prints that object as the last line of stdout, with "benchmark", "threads", "cpu",
-/// "vector_isa" and "omp_wait_policy" added
-/// (CONTRACTS.md: tracers -> tracer_steps_per_s, spray -> sim_seconds_per_wall_second,
-/// dem -> particle_steps_per_s, recurrence -> matrix_seconds, accuracy -> document).
+/// "vector_isa" and "omp_wait_policy" added (docs/contracts.md, "Benchmark output": tracers ->
+/// tracer_steps_per_s, spray -> sim_seconds_per_wall_second, dem -> particle_steps_per_s, recurrence ->
+/// matrix_seconds, accuracy -> document).
 
 #include <functional>
 #include <nlohmann/json.hpp>

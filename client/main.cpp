@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
   double interval = 1.0, reconnect = 600.0;
 
   auto* submit = app.add_subcommand("submit", "submit a job file (scene_file is inlined)");
-  submit->add_option("JOB", file, "job file (CONTRACTS.md)")->required();
+  submit->add_option("JOB", file, "job file (docs/contracts.md)")->required();
   submit->add_flag("--wait", wait, "wait for the job and show its progress");
   submit->add_option("--idempotency-key", key, "a retry with the same key returns the same job");
   auto* jobs = app.add_subcommand("jobs", "list jobs");

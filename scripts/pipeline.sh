@@ -34,9 +34,12 @@ rcfd wait "$cal"
 d0=$(rcfd result "$cal" | jq '.selected_d0')
 echo "calibration selected D0 = $d0 m2/s"
 
+# One tracer per particle for the coverage distribution (docs/accuracy.md: the scene's 20,000 tracers
+# serve the calibration's spray-zone statistics; the coverage's tail needs every particle).
 jq -n --slurpfile s "$scene" --arg db "$db" --argjson d0 "$d0" --argjson t "$spray_s" \
-  '{kind: "spray", scene: ($s[0] | .rcfd.d0 = $d0), database: $db, seed: 1, duration: $t,
-    checkpoint_interval: 60.0}' >"$out/spray-job.json"
+  '($s[0].particles) as $p | ($s[0].process.bed_mass / ($p.density * 3.141592653589793 / 6 * pow($p.diameter; 3)) + 0.5 | floor) as $n
+   | {kind: "spray", scene: ($s[0] | .rcfd.d0 = $d0 | .rcfd.tracers = $n), database: $db, seed: 1, duration: $t,
+      checkpoint_interval: 60.0}' >"$out/spray-job.json"
 spray=$(rcfd submit "$out/spray-job.json")
 echo "spray job $spray: $spray_s s of coating"
 rcfd wait "$spray"

@@ -19,7 +19,7 @@ struct sqlite3_stmt;
 
 namespace rcfd::server {
 
-/// Job states (STYLE.md): final states are past tense.
+/// Job states (docs/contracts.md, "HTTP API"): final states are past tense.
 namespace state {
 inline constexpr const char* queued = "QUEUED";
 inline constexpr const char* running = "RUNNING";

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <filesystem>
 #include <regex>
@@ -303,9 +304,12 @@ Response JobsApi::list(const Target& target, const Caller& caller) {
     filter.state = it->second;
   }
   if (auto it = target.query.find("kind"); it != target.query.end()) {
-    if (it->second != "database" && it->second != "calibration" && it->second != "spray")
-      return badParameter("kind", quotedValue(it->second) + " is not one of database, calibration, spray",
-                          target);
+    const std::vector<std::string>& kinds = jobKinds();
+    if (std::find(kinds.begin(), kinds.end(), it->second) == kinds.end()) {
+      std::string list;
+      for (const auto& k : kinds) list += (list.empty() ? "" : ", ") + k;
+      return badParameter("kind", quotedValue(it->second) + " is not one of " + list, target);
+    }
     filter.kind = it->second;
   }
   if (auto it = target.query.find("page_size"); it != target.query.end()) {

@@ -1,9 +1,9 @@
 #pragma once
 /// \file Router.hpp
-/// Maps a request to its handler (REST shape in STYLE.md), authenticates its caller by the bearer token
-/// (everything but GET /v1/health needs one; ServerConfig::users says whose it is) and answers health,
-/// schema and metrics requests itself. Job and database handlers get the caller: what is whose is
-/// decided there.
+/// Maps a request to its handler (REST shape: docs/contracts.md, "HTTP API"), authenticates its caller
+/// by the bearer token (everything but GET /v1/health needs one; ServerConfig::users says whose it is)
+/// and answers health, schema and metrics requests itself. Job and database handlers get the caller:
+/// what is whose is decided there.
 
 #include "DatabasesApi.hpp"
 #include "HttpTypes.hpp"

@@ -63,7 +63,8 @@ std::string signalName(int sig) {
   return name + " (" + std::to_string(sig) + ")";
 }
 
-/// Coverage histogram bins from summary.json (CONTRACTS.md: coverage.histogram.{edges,counts}).
+/// Coverage histogram bins from summary.json (coverage.histogram.{edges,counts}; docs/contracts.md,
+/// "summary.json").
 std::vector<CoverageBin> coverageBins(const nlohmann::json& summary) {
   std::vector<CoverageBin> bins;
   const auto cov = summary.find("coverage");

@@ -3,9 +3,9 @@
 /// Runs queued jobs as child processes `rcfd-solve run job.json --out DIR --progress-json`, at most
 /// `workers` at a time, oldest first. Each child is watched by its own thread (never an io_context
 /// thread): progress lines update the job row (throttled), stderr goes to DIR/solver.log, and the exit
-/// status decides the job's final state (CONTRACTS.md exit codes). A crash or kill of one solver fails
-/// only its job. Children get SIGTERM if the server dies (PR_SET_PDEATHSIG), so they checkpoint and the
-/// restarted server resumes them from the same out directory.
+/// status decides the job's final state (docs/contracts.md, "Exit codes"). A crash or kill of one
+/// solver fails only its job. Children get SIGTERM if the server dies (PR_SET_PDEATHSIG), so they
+/// checkpoint and the restarted server resumes them from the same out directory.
 
 #include <chrono>
 #include <condition_variable>

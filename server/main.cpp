@@ -1,4 +1,4 @@
-// rcfd-server: the HTTP/JSON job server (CONTRACTS.md, docs/api.md). This file reads the command
+// rcfd-server: the HTTP/JSON job server (docs/contracts.md, docs/api.md). This file reads the command
 // line, opens the store, starts the worker pool and the listener, and shuts down on SIGINT/SIGTERM:
 // stop accepting, then let running solvers checkpoint (their jobs resume on the next start).
 

@@ -31,7 +31,8 @@ struct StayStatistics {
   std::vector<double> edges;   ///< histogram bin edges [s], bins + 1 of them from 0
   std::vector<std::int64_t> counts;  ///< stays per bin
 
-  /// {"mean_s", "median_s", "p90_s", "stays", "censored", "histogram": {"edges", "counts"}} (CONTRACTS.md).
+  /// {"mean_s", "median_s", "p90_s", "stays", "censored", "histogram": {"edges", "counts"}}
+  /// (docs/contracts.md, "summary.json").
   nlohmann::json toJson() const;
 };
 

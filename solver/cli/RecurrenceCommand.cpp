@@ -169,7 +169,9 @@ const bool registered = addCommand(
       auto o = std::make_shared<Options>();
       app.add_option("DB", o->database, "field database (HDF5)")->required();
       app.add_option("--svg", o->svg, "write the recurrence plot (like the paper's Fig. 6)");
-      app.add_option("--norm", o->norm, "l2 (Eq. 6, default), l1 or max");
+      std::string norms;
+      for (const auto& n : kRecurrenceNorms) norms += std::string("\n  ") + n.name + ": " + n.doc;
+      app.add_option("--norm", o->norm, "distance between frames (default l2):" + norms);
       app.add_option("--field", o->field, "alpha_p (default), u_p.x|y|z or u_g.x|y|z");
       app.add_option("--sampling-field", o->samplingField, "field of the sampling criterion (default u_p.y)");
       app.add_option("--probe", o->probes, "probe point x,y,z [m] for the sampling criterion (repeatable; "

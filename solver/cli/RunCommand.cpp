@@ -1,4 +1,4 @@
-// rcfd-solve run JOB.json --out DIR [--progress-json]: runs one job locally (CONTRACTS.md).
+// rcfd-solve run JOB.json --out DIR [--progress-json]: runs one job locally (docs/contracts.md).
 #include <omp.h>
 
 #include <iostream>

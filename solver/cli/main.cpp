@@ -1,4 +1,4 @@
-// rcfd-solve: the solver's command line (CONTRACTS.md). Every sub-command lives in its own file and
+// rcfd-solve: the solver's command line (docs/contracts.md). Every sub-command lives in its own file and
 // registers itself through cli::addCommand; this file only parses and maps failures to exit codes.
 
 #include <spdlog/sinks/stdout_color_sinks.h>

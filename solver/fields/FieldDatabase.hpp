@@ -1,6 +1,6 @@
 #pragma once
 /// \file FieldDatabase.hpp
-/// The recurrence field database (HDF5, layout in docs/formats.md and CONTRACTS.md): the scene, the
+/// The recurrence field database (HDF5, layout in docs/formats.md): the scene, the
 /// grid with each cell's open fraction, dt_rec, and N frames of alpha_P, u_P and u_G as float32.
 /// Written one frame at a time (a crash leaves the frames written so far readable); read either all
 /// into RAM or through a bounded LRU frame cache.
@@ -75,7 +75,7 @@ struct FrameCacheStats {
   std::int64_t residentBytes = 0;
 };
 
-/// Names in the HDF5 layout (CONTRACTS.md, docs/formats.md).
+/// Names in the HDF5 layout (docs/formats.md).
 namespace layout {
 inline constexpr const char* formatName = "rcfd-field-database";
 inline constexpr int version = 1;

@@ -1,4 +1,4 @@
-// FieldDatabase::open: validation of the HDF5 layout (CONTRACTS.md, docs/formats.md) and the two ways
+// FieldDatabase::open: validation of the HDF5 layout (docs/formats.md) and the two ways
 // of serving frames: all in RAM, or an LRU cache bounded in bytes that reads frames on demand.
 
 #include <atomic>

@@ -1,4 +1,4 @@
-// FieldDatabaseWriter: creates the layout of CONTRACTS.md and appends one frame at a time. Each append
+// FieldDatabaseWriter: creates the layout of docs/formats.md and appends one frame at a time. Each append
 // extends the three extendible frame datasets (one frame per chunk), writes the frame, then updates
 // /frames@frame_count and flushes, so a writer killed between appends leaves a file that reads back
 // every completed frame (the default HDF5 superblock keeps no "open for writing" flag that would

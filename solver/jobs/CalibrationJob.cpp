@@ -28,6 +28,7 @@
 #include "core/Errors.hpp"
 #include "jobs/Cancellation.hpp"
 #include "jobs/JobRunner.hpp"
+#include "jobs/JobSupport.hpp"
 #include "jobs/Progress.hpp"
 #include "jobs/RecurrenceSetup.hpp"
 #include "tracers/FluctuationModel.hpp"
@@ -70,18 +71,6 @@ int threadBudget() {
 #endif
 }
 
-void setRunThreads(int n) {
-#ifdef _OPENMP
-  omp_set_num_threads(n);  // per-thread setting: applies to parallel regions this thread starts
-#else
-  (void)n;
-#endif
-}
-
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
 
 enum class RunOutcome { Finished, Stopped };
 
@@ -130,7 +119,7 @@ class CalibrationJob final : public JobRunner {
                                   {"discard_steps", discardSteps}, {"tracers", scene.rcfd.tracers},
                                   {"dt", scene.rcfd.dt},  {"database", job.database},
                                   {"effects", calibrationEffects(scene)}};
-      if (fs::exists(dir + "/key.json") && readJson(dir + "/key.json") != key) {
+      if (fs::exists(dir + "/key.json") && readJsonFile(dir + "/key.json") != key) {
         spdlog::warn("{} holds a run of other settings; starting D0 = {} afresh", dir, d0[i]);
         fs::remove_all(dir);
       }

@@ -1,6 +1,8 @@
 #pragma once
 /// \file JobRunner.hpp
-/// Job kinds ("database", "calibration", "spray") are runners registered by name. A runner reads its
+/// Job kinds ("database", "calibration", "spray") are runners registered by name; the job schema's
+/// `kind` enum names the same kinds (jobKinds() in SceneLoader.hpp, what the server offers; a test holds
+/// the two together). A runner reads its
 /// inputs, writes DIR/summary.json and DIR/result.h5 (and its own artifacts), checkpoints into DIR so
 /// that running the same job with the same DIR again resumes, and reports progress.
 

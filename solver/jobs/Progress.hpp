@@ -2,8 +2,8 @@
 /// \file Progress.hpp
 /// Progress of a running job: a human line on stderr and, with --progress-json, one JSON object per line
 /// on stdout ({"fraction","sim_time","wall_time","eta_s"} and, once the job names it, "phase";
-/// CONTRACTS.md) -- what the server's workers read. Throttled to about one report per `interval`
-/// seconds of wall time. The ETA uses the rate of the last minute (EtaEstimate).
+/// docs/contracts.md, "Progress") -- what the server's workers read. Throttled to about one report per
+/// `interval` seconds of wall time. The ETA uses the rate of the last minute (EtaEstimate).
 
 #include <chrono>
 #include <deque>

@@ -29,6 +29,7 @@
 #include "jobs/Cancellation.hpp"
 #include "jobs/Ensemble.hpp"
 #include "jobs/JobRunner.hpp"
+#include "jobs/JobSupport.hpp"
 #include "jobs/Progress.hpp"
 #include "jobs/RecurrenceSetup.hpp"
 #include "spray/Coverage.hpp"
@@ -123,18 +124,6 @@ int threadBudget() {
 #endif
 }
 
-void setThreads(int n) {
-#ifdef _OPENMP
-  omp_set_num_threads(n);  // per-thread setting: applies to the parallel regions this thread starts
-#else
-  (void)n;
-#endif
-}
-
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
 
 class TracerJob final : public JobRunner {
  public:
@@ -248,7 +237,7 @@ class TracerJob final : public JobRunner {
     auto finished = [&](int k) {
       const std::string dir = memberDir(k);
       if (!fs::exists(dir + "/summary.json") || !fs::exists(dir + "/result.h5")) return false;
-      const auto s = readJson(dir + "/summary.json");
+      const auto s = readJsonFile(dir + "/summary.json");
       return s.contains("seed") && s["seed"].get<std::uint64_t>() == seeds[std::size_t(k)];
     };
 
@@ -293,7 +282,7 @@ class TracerJob final : public JobRunner {
       const std::string dir = memberDir(k);
       fs::create_directories(dir);
       const std::uint64_t seed = seeds[std::size_t(k)];
-      setThreads(std::max(1, budget / running));
+      setRunThreads(std::max(1, budget / running));
       PathStatistics pathStats = rec.pathStats;
       const RecurrencePath path =
           k == 0 ? rec.path : generateRecurrencePath(scene, rec.matrix, steps + 2, seed, &pathStats);
@@ -313,7 +302,7 @@ class TracerJob final : public JobRunner {
           save();
           return;
         }
-        setThreads(std::max(1, budget / running));
+        setRunThreads(std::max(1, budget / running));
         sim.step();
         ++stepsDone;
         const std::int64_t done = ++stepsThisProcess;
@@ -357,7 +346,7 @@ class TracerJob final : public JobRunner {
       for (int w = 0; w < workers; ++w) pool.emplace_back(worker);
       for (auto& t : pool) t.join();
     }
-    setThreads(budget);
+    setRunThreads(budget);
     if (error) std::rethrow_exception(error);
     bool allFinished = true;
     for (int k = 0; k < members && allFinished; ++k) allFinished = finished(k);
@@ -379,7 +368,7 @@ class TracerJob final : public JobRunner {
     std::vector<nlohmann::json> memberSummaries;
     std::vector<std::string> memberFiles;
     for (int k = 0; k < members; ++k) {
-      memberSummaries.push_back(readJson(memberDir(k) + "/summary.json"));
+      memberSummaries.push_back(readJsonFile(memberDir(k) + "/summary.json"));
       memberFiles.push_back(memberDir(k) + "/result.h5");
     }
     nlohmann::json summary = memberSummaries.front();

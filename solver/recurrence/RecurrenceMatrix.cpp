@@ -16,20 +16,10 @@
 namespace rcfd {
 
 RecurrenceNorm parseRecurrenceNorm(const std::string& name, const std::string& pointer) {
-  if (name == "l2") return RecurrenceNorm::L2;
-  if (name == "l1") return RecurrenceNorm::L1;
-  if (name == "max") return RecurrenceNorm::Max;
-  throw InputError("recurrence", pointer, "\"" + name + "\" is not a norm; valid names are: l1 l2 max");
+  return parseNamedValue(kRecurrenceNorms, name, "recurrence", pointer);
 }
 
-std::string toString(RecurrenceNorm norm) {
-  switch (norm) {
-    case RecurrenceNorm::L2: return "l2";
-    case RecurrenceNorm::L1: return "l1";
-    case RecurrenceNorm::Max: return "max";
-  }
-  return "l2";
-}
+std::string toString(RecurrenceNorm norm) { return nameOf(kRecurrenceNorms, norm); }
 
 FieldComponent parseFieldComponent(const std::string& name, const std::string& pointer) {
   FieldComponent f;

@@ -11,19 +11,28 @@
 /// CFDEMcoupling-PFM's absDiffNorm and maxNorm; they have no Gram form and use a blocked direct loop.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/Registry.hpp"
 #include "fields/FieldDatabase.hpp"
 
 namespace rcfd {
 
 enum class RecurrenceNorm { L2, L1, Max };
 
-/// "l2", "l1" or "max"; rcfd::InputError naming `pointer` otherwise.
+/// The norms by name: `rcfd-solve recurrence --norm` and the stored matrix's `norm` attribute.
+inline constexpr std::array<NamedValue<RecurrenceNorm>, 3> kRecurrenceNorms{{
+    {"l2", RecurrenceNorm::L2, "Eq. (6): sum_c V_c (a_i - a_j)^2, through the Gram matrix"},
+    {"l1", RecurrenceNorm::L1, "sum_c V_c |a_i - a_j| (CFDEMcoupling-PFM's absDiffNorm)"},
+    {"max", RecurrenceNorm::Max, "max_c |a_i - a_j| over the open cells (CFDEMcoupling-PFM's maxNorm)"},
+}};
+
+/// The norm called `name`; rcfd::InputError naming `pointer` and the valid names otherwise.
 RecurrenceNorm parseRecurrenceNorm(const std::string& name, const std::string& pointer = "--norm");
 std::string toString(RecurrenceNorm norm);
 

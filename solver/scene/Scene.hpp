@@ -55,7 +55,13 @@ struct GasSpec {
   double cfl = 0.8;                      ///< largest Courant number of the adaptive gas time step [-]
   double max_time_step = 2.5e-5;         ///< upper bound of dt_CFD [s]
   double pressure_tolerance = 1e-8;      ///< relative residual of the pressure solver [-]
+  /// Preconditioner of the pressure CG, a name of gas::PreconditionerRegistry
+  /// ("mg": aggregation multigrid, "ic": incomplete Cholesky, "jacobi").
+  std::string pressure_preconditioner = "mg";
   double smoothing_length = 5.4e-3;      ///< L_smooth of Eq. (3), about three particle diameters [m]
+  /// Drag law F(eps, Re) of the coupling, a name of coupling::DragModelRegistry ("beetstra",
+  /// "gidaspow", "wen_yu").
+  std::string drag_model = "beetstra";
 };
 
 struct ParticleSpec {

@@ -29,7 +29,7 @@ std::vector<Violation> documentLimitViolations(const nlohmann::json& document);
 /// and the frames and reference samples fall on whole DEM steps (DatabaseSchedule).
 std::vector<Violation> checkDatabaseScene(const Scene& scene);
 
-/// Lower and upper corner of the apparatus's bounding box (CONTRACTS.md coordinates) [m].
+/// Lower and upper corner of the apparatus's bounding box (docs/contracts.md, "Coordinates") [m].
 void apparatusBounds(const ApparatusSpec& apparatus, Vec3& lower, Vec3& upper);
 
 }  // namespace rcfd

@@ -73,7 +73,9 @@ Scene sceneFromJson(const json& document) {
   read(gas, "cfl", s.gas.cfl);
   read(gas, "max_time_step", s.gas.max_time_step);
   read(gas, "pressure_tolerance", s.gas.pressure_tolerance);
+  read(gas, "pressure_preconditioner", s.gas.pressure_preconditioner);
   read(gas, "smoothing_length", s.gas.smoothing_length);
+  read(gas, "drag_model", s.gas.drag_model);
 
   const json& p = section(document, "particles");
   read(p, "diameter", s.particles.diameter);
@@ -174,7 +176,9 @@ json sceneToJson(const Scene& s) {
   doc["grid"] = {{"cell_size", vec(s.grid.cell_size)}};
   doc["gas"] = {{"density", s.gas.density}, {"kinematic_viscosity", s.gas.kinematic_viscosity},
                 {"cfl", s.gas.cfl}, {"max_time_step", s.gas.max_time_step},
-                {"pressure_tolerance", s.gas.pressure_tolerance}, {"smoothing_length", s.gas.smoothing_length}};
+                {"pressure_tolerance", s.gas.pressure_tolerance},
+                {"pressure_preconditioner", s.gas.pressure_preconditioner},
+                {"smoothing_length", s.gas.smoothing_length}, {"drag_model", s.gas.drag_model}};
   doc["particles"] = {{"diameter", s.particles.diameter}, {"density", s.particles.density},
                       {"youngs_modulus", s.particles.youngs_modulus},
                       {"poisson_ratio", s.particles.poisson_ratio}};

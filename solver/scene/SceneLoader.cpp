@@ -196,4 +196,10 @@ JobSpec loadJobFile(const std::string& path) {
 
 const std::string& schemaText(const std::string& name) { return SchemaValidator::get(name).text(); }
 
+const std::vector<std::string>& jobKinds() {
+  static const std::vector<std::string> kinds =
+      SchemaValidator::get("job").schema().at("properties").at("kind").at("enum").get<std::vector<std::string>>();
+  return kinds;
+}
+
 }  // namespace rcfd

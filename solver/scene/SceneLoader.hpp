@@ -16,7 +16,7 @@ namespace rcfd {
 
 /// A job file (schemas/job.schema.json); the scene is always resolved (scene_file read and validated).
 struct JobSpec {
-  std::string kind;           ///< "database", "calibration" or "spray"
+  std::string kind;           ///< one of jobKinds(): "database", "calibration" or "spray"
   Scene scene;
   std::string database;       ///< database path (CLI) or job id (server); empty for database jobs
   double duration = 0.0;      ///< simulated seconds (spray; calibration: per D0) [s]
@@ -50,5 +50,10 @@ void requireJobRules(const JobSpec& job);
 
 /// The text of an embedded schema by name ("scene", "job"); throws std::out_of_range otherwise.
 const std::string& schemaText(const std::string& name);
+
+/// The job kinds, the job schema's `kind` enum in its order: what a job document may name and what the
+/// server lists and filters by. The runners of `rcfd-solve run` are registered under the same names
+/// (JobRunnerRegistry; the test Choices.JobKindsAreTheRegisteredRunners holds the two together).
+const std::vector<std::string>& jobKinds();
 
 }  // namespace rcfd

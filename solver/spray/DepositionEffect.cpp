@@ -1,4 +1,7 @@
-// deposition: per step each parcel loses the fraction eta (Eq. 11-14) of its droplets into its cell.
+// deposition: a parcel loses the fraction eta (Eq. 11-14) of its droplets over every sub-step of its
+// flight, in the cell of the sub-step's midpoint, for the time it spends on it (the `spray` effect asks
+// ParcelDeposition::efficiency() as it moves the parcels, so the deposit does not depend on how many
+// cells a parcel crosses in one rCFD step, and a parcel that reaches a wall deposits on its way there).
 // alpha_P in Eq. (11) is the tracers' own volume fraction, so deposited droplets always have tracers to
 // go to. Droplets are discrete: the droplets stripped in a cell are handed out whole, each to a tracer of
 // that cell drawn at random (a fraction of a droplet waits in the cell for the next step); a tracer's
@@ -6,13 +9,14 @@
 // as in the paper, a well-mixed bed thus collects Poisson-distributed droplet counts, as real particles
 // do. Parcels with fewer than one droplet left are removed (N_D,min = 1, the paper).
 //
-// Determinism: per-parcel efficiencies run in parallel; the books, the per-cell carry and the random
-// hand-out run in parcel, cell and tracer order with counter-based random numbers keyed by (cell, step).
+// Determinism: the books of the deposits are kept in a fixed order by `spray`; the per-cell carry and the
+// random hand-out run in cell and tracer order with counter-based random numbers keyed by (cell, step).
 #include <omp.h>
 
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include "core/Permutation.hpp"
@@ -25,14 +29,13 @@
 namespace rcfd {
 namespace {
 
-constexpr double kMinDropletsPerParcel = 1.0;  ///< N_D,min of the paper
 constexpr std::int64_t kPicksPerBinomial = 32;  ///< see DepositionEffect::distribute
 constexpr std::int64_t kScanBlock = 256;        ///< tracers tested together in DepositionEffect::handOut
 /// Whole droplets one cell hands out in one step at most: 2^53, below which whole numbers are exact in
 /// double (and far inside int64). Reached only by droplets of a fraction of a micrometre.
 constexpr double kMaxDropletsPerHandOut = 9007199254740992.0;
 
-class DepositionEffect final : public TracerEffect {
+class DepositionEffect final : public TracerEffect, public ParcelDeposition {
  public:
   explicit DepositionEffect(TracerContext& ctx)
       : model_(DepositionModelRegistry::create(ctx.scene.spray.deposition_model)), state_(ctx.spray) {
@@ -47,6 +50,10 @@ class DepositionEffect final : public TracerEffect {
     due_.assign(std::size_t(ctx.grid.cellCount()), 0);
     slot_.assign(std::size_t(ctx.grid.cellCount()), -1);
     dueBits_.assign((std::size_t(ctx.grid.cellCount()) + 31) / 32, 0);
+    state_->deposition = this;
+  }
+  ~DepositionEffect() override {
+    if (state_->deposition == this) state_->deposition = nullptr;
   }
 
   std::size_t allocatedBytes() const override {
@@ -57,7 +64,7 @@ class DepositionEffect final : public TracerEffect {
 
   bool afterMoveBesideMotion() const override { return true; }
   void afterMove(TracerContext& ctx) override {
-    stripParcels(ctx);
+    collectTouchedCells();
     handOut(ctx);
   }
 
@@ -77,51 +84,30 @@ class DepositionEffect final : public TracerEffect {
   }
 
  private:
-  void stripParcels(TracerContext& ctx) {
-    auto& s = *state_;
-    auto& pc = s.parcels;
-    const std::int64_t n = std::int64_t(pc.size());
-    s.parcelDeposit.assign(std::size_t(n), 0.0);
-    s.parcelCell.assign(std::size_t(n), 0);
+  void beginStep(TracerContext& ctx) override {
+    tracerAlpha_ = ctx.tracerAlpha.data();
     // |u_G - u_P| from the step fields the spray parcels and the motion kernel read (float trilinear):
-    // 2 x 8 corners in double per parcel cost as much as moving the parcels.
-    const FrameSampler sampler = ctx.sampler();
-    const StepFieldSampler gas(ctx.stepVelocity(true, StepFieldLayout::Any), sampler.locator());
-    const StepFieldSampler particles(ctx.stepVelocity(false), sampler.locator());
-#pragma omp parallel for schedule(static) if (n > kParallelThreshold)
-    for (std::int64_t j = 0; j < n; ++j) {
-      const Eigen::Vector3d p = pc.position(std::size_t(j));
-      const auto cell = std::int32_t(ctx.grid.flatIndexOf(p));
-      s.parcelCell[std::size_t(j)] = cell;
-      const double alphaP = ctx.tracerAlpha[std::size_t(cell)];
-      // No tracers, no deposition (eta = 0, Eq. 11): most airborne parcels are above the bed, and the
-      // two velocity samples are the dear part.
-      if (!(alphaP > 0.0)) continue;
-      const DepositionInput in{alphaP, (gas.sample(p) - particles.sample(p)).norm(), ctx.dt};
-      s.parcelDeposit[std::size_t(j)] = pc.droplets[std::size_t(j)] * model_->efficiency(in, constants_);
-    }
-    // Only the cells of the last step's deposits hold anything: zeroed one by one, not all 74k.
-    for (const std::int32_t c : s.depositCells) s.cellDeposit[std::size_t(c)] = 0.0;
-    s.depositCells.clear();
-    std::size_t keep = 0;
-    for (std::size_t j = 0; j < std::size_t(n); ++j) {
-      const double dep = s.parcelDeposit[j];
-      const auto c = std::size_t(s.parcelCell[j]);
-      if (dep > 0.0) {
-        if (s.cellDeposit[c] == 0.0) s.depositCells.push_back(std::int32_t(c));
-        s.cellDeposit[c] += dep;
-        s.balance.deposited += dep;
-      }
-      const double left = pc.droplets[j] - dep;
-      if (left < kMinDropletsPerParcel) {
-        s.balance.residual += left;
-        continue;
-      }
-      pc.x[keep] = pc.x[j], pc.y[keep] = pc.y[j], pc.z[keep] = pc.z[j];
-      pc.droplets[keep] = left, pc.id[keep] = pc.id[j];
-      ++keep;
-    }
-    pc.x.resize(keep), pc.y.resize(keep), pc.z.resize(keep), pc.droplets.resize(keep), pc.id.resize(keep);
+    // 2 x 8 corners in double per sample cost as much as moving the parcels.
+    frames_.emplace(ctx.sampler());
+    gas_.emplace(ctx.stepVelocity(true, StepFieldLayout::Any), frames_->locator());
+    particles_.emplace(ctx.stepVelocity(false), frames_->locator());
+    grid_ = &ctx.grid;
+  }
+
+  double efficiency(const Eigen::Vector3d& mid, double seconds, std::int32_t& cell) const override {
+    cell = std::int32_t(grid_->flatIndexOf(mid));
+    const double alphaP = tracerAlpha_[std::size_t(cell)];
+    // No tracers, no deposition (eta = 0, Eq. 11): most airborne parcels are above the bed, and the
+    // two velocity samples are the dear part.
+    if (!(alphaP > 0.0)) return 0.0;
+    const DepositionInput in{alphaP, (gas_->sample(mid) - particles_->sample(mid)).norm(), seconds};
+    return model_->efficiency(in, constants_);
+  }
+
+  /// The cells with new deposits (booked by `spray` as the parcels moved), pending fractions or
+  /// droplets waiting from the last step.
+  void collectTouchedCells() {
+    const auto& s = *state_;
     touched_.assign(s.depositCells.begin(), s.depositCells.end());
     if (!pendingCellsKnown_) {  // first step of a run or of a resume: find cells keeping a fraction
       for (std::size_t c = 0; c < s.cellPending.size(); ++c) {
@@ -268,6 +254,11 @@ class DepositionEffect final : public TracerEffect {
   std::unique_ptr<DepositionModel> model_;
   std::shared_ptr<SprayState> state_;
   DepositionConstants constants_;
+  // Of the step the parcels are moving in (beginStep):
+  const CartesianGrid* grid_ = nullptr;
+  const float* tracerAlpha_ = nullptr;
+  std::optional<FrameSampler> frames_;
+  std::optional<StepFieldSampler> gas_, particles_;
   std::vector<std::int64_t> due_;       ///< whole droplets due per cell this step
   std::vector<std::int32_t> touched_;   ///< cells with new or pending droplets this step
   std::vector<std::int32_t> waiting_;   ///< cells keeping a fraction of a droplet

@@ -1,6 +1,7 @@
 // spray: droplet parcels injected at the nozzle into the spray cone and carried by u_G^rec (their
 // relaxation time is below 5 ms, the paper). A parcel that reaches a wall, plate or the inlet, or leaves
-// through the outlet, is overspray.
+// through the outlet, is overspray. With `deposition`, parcels deposit along every sub-step of their
+// flight (ParcelDeposition), and the books of those deposits are kept here, in block order.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -37,7 +38,9 @@ class SprayEffect final : public TracerEffect {
   }
 
   std::size_t allocatedBytes() const override {
-    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + exit_.capacity();
+    std::size_t deposits = blockDeposits_.capacity() * sizeof(blockDeposits_[0]);
+    for (const auto& d : blockDeposits_) deposits += d.capacity() * sizeof(StrippedDroplets);
+    return sizeof(SprayState) + clearance_.capacity() * sizeof(float) + exit_.capacity() + deposits;
   }
 
   bool afterMoveBesideMotion() const override { return true; }
@@ -53,7 +56,7 @@ class SprayEffect final : public TracerEffect {
     const double m = s.dropletMass;
     const double airborne = s.airborne();
     const double overspray = b.oversprayWall + b.oversprayOutlet;
-    // residual: parcels removed with fewer than one droplet left (the and CONTRACTS.md's term);
+    // residual: parcels removed with fewer than one droplet left (docs/contracts.md, "Mass balance");
     // closure_error: what the books fail to account for (round-off only).
     const double closure = b.injected - (b.deposited + airborne + overspray + b.residual);
     double pending = 0.0;
@@ -136,7 +139,9 @@ class SprayEffect final : public TracerEffect {
   void moveParcels(TracerContext& ctx, SprayState& s) {
     auto& pc = s.parcels;
     const std::int64_t n = std::int64_t(pc.size());
+    if (s.deposition) s.clearStepDeposits();
     if (n == 0) return;
+    if (s.deposition) s.deposition->beginStep(ctx);
     exit_.assign(std::size_t(n), 0);  // 0 airborne, 1 wall, 2 outlet
     const FrameSampler frames = ctx.sampler();
     // u_G^rec of the step as a step field: parcels read its corners with the tracer kernel's block
@@ -144,21 +149,32 @@ class SprayEffect final : public TracerEffect {
     // corners in double per sub-step. On a frame, the frame's own array: ~1,300 samples per step do not
     // pay for a copy of all 74k cells.
     const StepVelocityField& gas = ctx.stepVelocity(true, StepFieldLayout::Any);
-    BlockMove move{gas.floats(), frames.locator().constants(), {}, CellIndexer(ctx.grid), ctx.dt, minSpacing_};
+    BlockMove move{gas.floats(),  frames.locator().constants(), {}, CellIndexer(ctx.grid), ctx.dt, minSpacing_,
+                   s.deposition};
     move.corners.set(frames.locator().offsets32(), gas.stride());
     const std::int64_t blocks = (n + block::kBlock - 1) / block::kBlock;
+    if (blockDeposits_.size() < std::size_t(blocks)) blockDeposits_.resize(std::size_t(blocks));
     // Blocks start at multiples of kBlock and parcels are independent: the same for any thread count.
 #pragma omp parallel for schedule(dynamic, 1) if (n > kParallelThreshold)  // sub-steps vary: dynamic
     for (std::int64_t b = 0; b < blocks; ++b) {
       const std::int64_t j0 = b * block::kBlock;
-      moveBlock(ctx, move, pc, j0, int(std::min<std::int64_t>(block::kBlock, n - j0)));
+      auto& deposits = blockDeposits_[std::size_t(b)];
+      deposits.clear();
+      moveBlock(ctx, move, pc, j0, int(std::min<std::int64_t>(block::kBlock, n - j0)), deposits);
     }
-    // Serial, in parcel order: the books and the compaction are the same for any thread count.
+    // Serial, in block order: the books and the compaction are the same for any thread count.
+    for (std::int64_t b = 0; b < blocks; ++b) {
+      for (const StrippedDroplets& d : blockDeposits_[std::size_t(b)]) s.bookDeposit(d.cell, d.droplets);
+    }
     std::size_t keep = 0;
     for (std::size_t j = 0; j < std::size_t(n); ++j) {
       if (exit_[j] == 1) s.balance.oversprayWall += pc.droplets[j];
       if (exit_[j] == 2) s.balance.oversprayOutlet += pc.droplets[j];
       if (exit_[j] != 0) continue;
+      if (pc.droplets[j] < kMinDropletsPerParcel) {
+        s.balance.residual += pc.droplets[j];
+        continue;
+      }
       if (keep != j) {
         pc.x[keep] = pc.x[j], pc.y[keep] = pc.y[j], pc.z[keep] = pc.z[j];
         pc.droplets[keep] = pc.droplets[j], pc.id[keep] = pc.id[j];
@@ -176,6 +192,13 @@ class SprayEffect final : public TracerEffect {
     CellIndexer indexer;
     double dt;
     double spacing;                         ///< smallest cell spacing [m]
+    const ParcelDeposition* deposition;     ///< null: parcels only fly
+  };
+
+  /// Droplets a parcel left in a cell over one sub-step.
+  struct StrippedDroplets {
+    std::int32_t cell;
+    double droplets;
   };
 
   /// Lanes of a block of parcels still moving, compacted after every sub-step round.
@@ -197,8 +220,11 @@ class SprayEffect final : public TracerEffect {
   /// Parcels j0 .. j0 + count - 1 through the step: sub-steps so that none moves farther than one
   /// cell at its start velocity (particle Courant number <= 1, at most 64), u_G^rec sampled at every
   /// sub-step's start; a sub-step that may reach a boundary gets the exact segment test, and a hit
-  /// ends the parcel there (overspray). Rounds run on the lanes with sub-steps left, compacted.
-  void moveBlock(const TracerContext& ctx, const BlockMove& bm, ParcelCloud& pc, std::int64_t j0, int count) {
+  /// ends the parcel there (overspray). Over every sub-step (up to the hit) the parcel deposits the
+  /// fraction bm.deposition gives for its midpoint and duration, appended to `deposits` in the order
+  /// taken. Rounds run on the lanes with sub-steps left, compacted.
+  void moveBlock(const TracerContext& ctx, const BlockMove& bm, ParcelCloud& pc, std::int64_t j0, int count,
+                 std::vector<StrippedDroplets>& deposits) {
     constexpr int kMaxParcelSubsteps = 64;
     ParcelLanes L;
     for (int k = 0; k < count; ++k) {
@@ -233,11 +259,24 @@ class SprayEffect final : public TracerEffect {
         const Eigen::Vector3d end = p + L.h[k] * Eigen::Vector3d(L.ux[k], L.uy[k], L.uz[k]);
         Eigen::Vector3d at = end;
         bool done = --L.left[k] == 0;
+        double seconds = L.h[k];
         if (!fast[k]) {
           if (const auto hit = ctx.apparatus.firstIntersection(p, end)) {
             exit_[std::size_t(j0 + L.parcel[k])] = hit->kind == BoundaryKind::Outlet ? 2 : 1;
+            const double full = (end - p).norm();
+            seconds = full > 0.0 ? L.h[k] * std::min(1.0, (hit->point - p).norm() / full) : 0.0;
             at = hit->point;
             done = true;
+          }
+        }
+        if (bm.deposition && seconds > 0.0) {
+          const std::size_t j = std::size_t(j0 + L.parcel[k]);
+          std::int32_t cell = -1;
+          const double eta = bm.deposition->efficiency(0.5 * (p + at), seconds, cell);
+          if (eta > 0.0) {
+            const double stripped = pc.droplets[j] * eta;
+            pc.droplets[j] -= stripped;
+            deposits.push_back({cell, stripped});
           }
         }
         if (done) {
@@ -261,6 +300,7 @@ class SprayEffect final : public TracerEffect {
   double minSpacing_ = 1.0;
   std::vector<float> clearance_;  ///< per cell: moves shorter than this hit no boundary [m]
   std::vector<std::int8_t> exit_; ///< per parcel of the step: 0 airborne, 1 wall, 2 outlet
+  std::vector<std::vector<StrippedDroplets>> blockDeposits_;  ///< per block of parcels: its deposits this step
 };
 
 const bool registered = TracerEffectRegistry::add(

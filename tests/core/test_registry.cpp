@@ -40,6 +40,37 @@ TEST(Registry, RefusesDuplicateNames) {
                std::logic_error);
 }
 
+TEST(Registry, CreateAtRefusesAnUnknownNameAsAnInputErrorAtItsPointer) {
+  EXPECT_DOUBLE_EQ(ShapeRegistry::createAt("scene", "/shape", "square", 2.0)->area(), 4.0);
+  try {
+    ShapeRegistry::createAt("scene", "/shape", "circle", 1.0);
+    FAIL() << "expected rcfd::InputError";
+  } catch (const rcfd::InputError& e) {
+    ASSERT_EQ(e.violations().size(), 1u);
+    EXPECT_EQ(e.violations()[0].pointer, "/shape");
+    EXPECT_EQ(e.violations()[0].message, ShapeRegistry::unknownNameMessage("circle"));
+  }
+}
+
+namespace {
+enum class Colour { Red, Green };
+constexpr std::array<rcfd::NamedValue<Colour>, 2> kColours{{{"red", Colour::Red, "warm"}, {"green", Colour::Green, "cool"}}};
+}  // namespace
+
+TEST(NamedValue, ParsesNamesAndRefusesWithTheRegistrysMessage) {
+  EXPECT_EQ(rcfd::parseNamedValue(kColours, "green", "scene", "/colour"), Colour::Green);
+  EXPECT_STREQ(rcfd::nameOf(kColours, Colour::Red), "red");
+  EXPECT_EQ(rcfd::namesOf(kColours), (std::vector<std::string>{"green", "red"}));
+  try {
+    rcfd::parseNamedValue(kColours, "blue", "scene", "/colour");
+    FAIL() << "expected rcfd::InputError";
+  } catch (const rcfd::InputError& e) {
+    ASSERT_EQ(e.violations().size(), 1u);
+    EXPECT_EQ(e.violations()[0].pointer, "/colour");
+    EXPECT_EQ(e.violations()[0].message, "unknown name \"blue\"; valid names are: green red");
+  }
+}
+
 TEST(Errors, InputErrorListsEveryViolation) {
   rcfd::InputError e("scene.json", {{"/a", "bad"}, {"/b/0", "worse"}});
   const std::string text = e.what();

@@ -37,9 +37,9 @@ TEST(GasProCell, InletAndNozzleCarryTheSceneFlows) {
 /// zero-sum residual (1e-14 q), incomplete Cholesky or Jacobi with up to 4e-7 q (IC, draft plates as
 /// baffles, step 3) while every cell meets the tolerance.
 void expectMassConserved(bool plates, const std::string& preconditioner = "mg", double balance = 1e-7) {
-  gas::GasOptions o;
-  o.preconditioner = preconditioner;
-  GasCase c(quickSliceScene(plates), o);
+  Scene scene = quickSliceScene(plates);
+  scene.gas.pressure_preconditioner = preconditioner;
+  GasCase c(scene);
   auto& g = *c.solver;
   const double q = c.scene.process.gas_flow_rate + c.scene.process.atomisation_flow_rate;
   for (int n = 0; n < 15; ++n) {

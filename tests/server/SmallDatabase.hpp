@@ -2,7 +2,7 @@
 // A small field database for server tests and the server benchmark: the scene's grid with a spout
 // swaying left and right (period 0.25 s) and an annulus sliding down, so tracers cross the spray zone
 // and frames differ for the recurrence path. Written with rcfd::writeAnalyticDatabase (the real
-// writer, the CONTRACTS.md layout), so a spray job on it runs the real solver. Header-only so both
+// writer, the docs/formats.md layout), so a spray job on it runs the real solver. Header-only so both
 // tests/server and bench/server_load.cpp can include it.
 
 #include <cmath>

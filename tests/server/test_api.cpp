@@ -149,7 +149,7 @@ TEST_F(Api, SchemaViolationIs422WithPointer) {
   EXPECT_TRUE(found) << r.body;
 
   auto unknown = databaseJob();
-  unknown["colour"] = "blue";  // unknown keys are errors (CONTRACTS.md)
+  unknown["colour"] = "blue";  // unknown keys are errors (docs/contracts.md)
   const auto r2 = server_->post("/v1/jobs", unknown.dump());
   expectProblem(r2, 422);
   expectStillServing();

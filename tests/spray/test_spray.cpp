@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <utility>
 
 #include "spray/Coverage.hpp"
+#include "spray/DepositionEfficiency.hpp"
 #include "spray/SprayState.hpp"
 #include "SprayTestSupport.hpp"
 
@@ -298,4 +300,79 @@ TEST(Spray, OneAndTwoThreadsAndResumeAreBitIdentical) {
   EXPECT_EQ(std::memcmp(dropletsOne.data(), dropletsTwo.data(), dropletsOne.size() * sizeof(double)), 0);
   EXPECT_EQ(std::memcmp(dropletsOne.data(), dropletsResumed.data(), dropletsOne.size() * sizeof(double)), 0);
   EXPECT_GT(one["mass_balance"]["on_tracers_kg"].get<double>(), 0.0);
+}
+
+TEST(Spray, AParcelDepositsAlongItsWholeFlightWhateverTheRcfdStep) {
+  // A uniform bed (the same number of resting tracers in every cell) in a uniform updraft U: over any
+  // piece of its flight a parcel keeps exp(-k t) of its droplets (the exponential form of Eq. 11), with k
+  // fixed by alpha_P and the slip U. So an airborne parcel holds N0 exp(-k t) after t in the air, and a
+  // parcel that left through the top took between (0.2 m - y_start) / U to get there, for an rCFD step
+  // of 1 ms (under a cell per step) as for 20 ms (8 cells per step, in sub-steps): the deposit follows
+  // the parcel's path, not the cells it ends its steps in.
+  constexpr double U = 4.0, kHeight = 0.2;
+  for (const double dt : {1e-3, 5e-3, 20e-3}) {
+    SCOPED_TRACE("dt = " + std::to_string(dt));
+    Scene s = sprayBoxScene(6400, 0.006);  // a dilute bed: about half the droplets reach the top
+    s.effects = {"tracer_volume_fraction", "spray", "deposition"};
+    s.rcfd.dt = dt;
+    const CartesianGrid grid = gridOf(s);
+    ASSERT_EQ(grid.cellCount() * 8, s.rcfd.tracers);
+    auto db = database(s, 4, dt, [&](int, double, FieldFrame& f) {
+      for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+        f.alpha_p[std::size_t(c)] = 0.006f;
+        f.u_g[3 * c + 1] = float(U);
+      }
+    });
+    const auto steps = std::int64_t(std::llround(0.3 / dt));
+    TracerSimulation sim(s, db, sequentialPath(db->frameCount(), steps + 2), {11, steps, 0});
+    {  // eight tracers per cell, on a lattice: the tracers' alpha_P is the same in every cell
+      TracerCloud& cloud = sim.context().cloud;
+      std::size_t i = 0;
+      for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+        const auto ijk = grid.cellIjk(c);
+        const Eigen::Vector3d centre = grid.cellCenter(ijk[0], ijk[1], ijk[2]);
+        for (int corner = 0; corner < 8; ++corner) {
+          const Eigen::Vector3d offset(corner & 1 ? 0.25 : -0.25, corner & 2 ? 0.25 : -0.25, corner & 4 ? 0.25 : -0.25);
+          cloud.setPosition(i++, centre + grid.spacing.cwiseProduct(offset));
+        }
+      }
+    }
+    for (std::int64_t k = 0; k < steps; ++k) sim.step();
+    const TracerContext& ctx = std::as_const(sim).context();
+    const SprayState& spray = *ctx.spray;
+    const float alpha = ctx.tracerAlpha.at(0);
+    ASSERT_GT(alpha, 0.0f);
+    for (const float a : ctx.tracerAlpha) ASSERT_EQ(a, alpha);
+    const auto model = DepositionModelRegistry::create(s.spray.deposition_model);
+    DepositionConstants constants;
+    constants.particleDiameter = s.particles.diameter;
+    constants.dropletDiameter = s.spray.droplet_diameter;
+    constants.dropletDensity = s.spray.droplet_density;
+    constants.gasDensity = s.gas.density;
+    constants.gasViscosity = s.gas.kinematic_viscosity;
+    const double k = -std::log1p(-model->efficiency({double(alpha), U, 1e-3}, constants)) / 1e-3;
+    const double n0 = spray.dropletsPerParcel;
+    const double tMin = (kHeight - 0.005 - 0.5 * s.spray.nozzle_diameter - 0.01) / U;
+    const double tMax = (kHeight - 0.005) / U;
+    ASSERT_GT(k * tMax, 0.2);  // a deposit to measure, and parcels that leave with most droplets too
+    ASSERT_LT(k * tMax, 3.0);
+
+    const auto perStep = std::int64_t(std::llround(s.spray.parcels_per_s * dt));
+    ASSERT_GT(spray.parcels.size(), 0u);
+    for (std::size_t j = 0; j < spray.parcels.size(); ++j) {
+      const std::int64_t injectedIn = spray.parcels.id[j] / perStep;
+      const double airborne = double(steps - 1 - injectedIn) * dt;
+      ASSERT_NEAR(spray.parcels.droplets[j], n0 * std::exp(-k * airborne), 1e-6 * n0) << "parcel " << j;
+    }
+    const auto summary = results(sim, "along-path");
+    const auto& m = summary["mass_balance"];
+    EXPECT_EQ(m["overspray_wall_kg"].get<double>(), 0.0);
+    EXPECT_EQ(m["residual_kg"].get<double>(), 0.0);
+    EXPECT_LE(std::abs(closure(m)), 1e-12 * m["injected_kg"].get<double>());
+    const double left = double(summary["parcels"]["injected"].get<std::int64_t>()) - double(spray.parcels.size());
+    ASSERT_GT(left, 20.0);
+    const double perParcel = m["overspray_outlet_kg"].get<double>() / spray.dropletMass / left;
+    EXPECT_GE(perParcel, n0 * std::exp(-k * tMax) * (1.0 - 1e-9));
+    EXPECT_LE(perParcel, n0 * std::exp(-k * tMin) * (1.0 + 1e-9));
+  }
 }

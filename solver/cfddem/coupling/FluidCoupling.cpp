@@ -16,11 +16,7 @@ constexpr double kMinGasFraction = 0.2;
 
 FluidCoupling::FluidCoupling(const Scene& scene, gas::GasSolver& gas, DemSystem& dem, FluidCouplingOptions options)
     : scene_(scene), gas_(gas), dem_(dem), options_(std::move(options)) {
-  try {
-    model_ = DragModelRegistry::create(options_.dragModel, scene_);
-  } catch (const std::out_of_range& e) {
-    throw InputError("scene", "/effects", std::string("drag model: ") + e.what());
-  }
+  model_ = DragModelRegistry::createAt("scene", "/gas/drag_model", scene_.gas.drag_model, scene_);
   mapping_ = std::make_unique<VolumeMapping>(gas_.grid(), gas_.openFraction(), gas_.activeCells(),
                                              gas_.apertures().baffles);
   if (options_.smoothingLength > 0)

@@ -28,7 +28,6 @@ struct FluidCouplingOptions {
   bool drag = true;            ///< effect `drag`: drag and the exchange to the gas; else none
   bool pressureForce = true;   ///< -V_p grad p on the parcels (model A)
   double smoothingLength = 0;  ///< effect `smoothing`: Eq. (3) with this L_smooth [m]; 0 off
-  std::string dragModel = kDefaultDragModel;
   double maxParticleFraction = kMaxParticleFraction;
 };
 
@@ -67,6 +66,8 @@ class FluidCoupling {
   void restoreFraction(std::vector<double> alphaP);
   /// Drag force on each parcel of the last applyForces() [N] (index order).
   const std::vector<Eigen::Vector3d>& dragForces() const { return drag_; }
+  /// The drag law F(eps, Re), the scene's gas.drag_model.
+  const DragModel& dragModel() const { return *model_; }
 
  private:
   std::vector<Eigen::Vector3d> gasVelocitySeen() const;

@@ -29,13 +29,9 @@ std::string cellText(const CartesianGrid& g, std::size_t c) {
 GasSolver::GasSolver(const Scene& scene, const Apparatus& apparatus, const CartesianGrid& grid,
                      GasOptions options)
     : scene_(scene), apparatus_(apparatus), grid_(grid), options_(std::move(options)) {
-  Preconditioner pc{};
-  try {
-    pc = parsePreconditioner(options_.preconditioner);
-  } catch (const std::invalid_argument& e) {
-    throw InputError("gas solver options", "/preconditioner", e.what());
-  }
-  pressureSolver_ = std::make_unique<PressureSolver>(pc, options_.refactorInterval);
+  pressureSolver_ = std::make_unique<PressureSolver>(
+      PreconditionerRegistry::createAt("scene", "/gas/pressure_preconditioner", scene_.gas.pressure_preconditioner),
+      options_.refactorInterval);
   const std::size_t n = std::size_t(grid_.cellCount());
   phi_ = openFractions(apparatus_, grid_);
   alpha_.assign(n, 1.0);

@@ -37,7 +37,6 @@ inline constexpr std::size_t kParallelFaces = 10000;
 
 /// Settings that are not in the scene (solver choices and verification set-ups).
 struct GasOptions {
-  std::string preconditioner = "mg";  ///< "mg" (aggregation multigrid), "ic" (incomplete Cholesky) or "jacobi"
   int refactorInterval = 20;          ///< steps between preconditioner rebuilds (IC, mg) while the matrix drifts
   int maxPressureIterations = 2000;
   /// The front and back walls (z = 0, z = depth) without friction: plane flow in a slice. Default

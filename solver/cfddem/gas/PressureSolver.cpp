@@ -2,63 +2,30 @@
 
 #include "cfddem/gas/PressureSolver.hpp"
 
-#include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace rcfd::gas {
 
-Preconditioner parsePreconditioner(const std::string& name) {
-  if (name == "ic") return Preconditioner::IncompleteCholesky;
-  if (name == "jacobi") return Preconditioner::Jacobi;
-  if (name == "mg") return Preconditioner::Multigrid;
-  throw std::invalid_argument("unknown pressure preconditioner \"" + name + "\"; valid names are: ic jacobi mg");
-}
-
-struct PressureSolver::IcHolder {
-  // Natural ordering keeps the lexicographic order of the grid, for which IC works well on a 7-point
-  // Laplacian; Eigen's IC adds a diagonal shift by itself if a pivot turns non-positive.
-  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> factor;
-};
-
-PressureSolver::PressureSolver(Preconditioner kind, int refactorInterval)
-    : kind_(kind), refactorInterval_(refactorInterval) {}
+PressureSolver::PressureSolver(std::unique_ptr<PressurePreconditioner> preconditioner, int refactorInterval)
+    : preconditioner_(std::move(preconditioner)), refactorInterval_(refactorInterval) {}
 
 PressureSolver::~PressureSolver() = default;
 
 void PressureSolver::setCells(std::vector<std::array<int, 3>> cellOf) {
-  cells_ = std::move(cellOf);
-  mg_.reset();
+  preconditioner_->setCells(cellOf);
+  built_ = false;
 }
 
 void PressureSolver::setMatrix(const Matrix& a, bool force) {
   const bool newPattern = a.rows() != a_.rows() || a.nonZeros() != a_.nonZeros();
   a_ = a;
-  inverseDiagonal_ = a_.diagonal().cwiseInverse();
-  if (kind_ == Preconditioner::Multigrid) {
-    if (!mg_ || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
-      if (cells_.size() != std::size_t(a_.rows())) throw std::logic_error("multigrid: setCells() not called");
-      if (!mg_) mg_ = std::make_unique<AggregationMultigrid>(cells_);
-      mg_->compute(a_);
-      sinceFactor_ = 0;
-    }
-    return;
-  }
-  if (kind_ != Preconditioner::IncompleteCholesky) return;
-  if (!ic_ || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
-    if (!ic_) ic_ = std::make_unique<IcHolder>();
-    Eigen::SparseMatrix<double> colMajor = a_;
-    ic_->factor.compute(colMajor);
-    if (ic_->factor.info() != Eigen::Success) throw std::runtime_error("incomplete Cholesky of the pressure matrix failed");
+  if (!built_ || !preconditioner_->reusable() || newPattern || force || ++sinceFactor_ >= refactorInterval_) {
+    preconditioner_->build(a_);
+    built_ = true;
     sinceFactor_ = 0;
   }
-}
-
-void PressureSolver::applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
-  if (kind_ == Preconditioner::IncompleteCholesky) z = ic_->factor.solve(r);
-  else if (kind_ == Preconditioner::Multigrid) mg_->apply(r, z);
-  else z = inverseDiagonal_.cwiseProduct(r);
 }
 
 namespace {
@@ -112,7 +79,7 @@ PressureSolveStats PressureSolver::solve(const Eigen::VectorXd& b, Eigen::Vector
     stats.converged = true;
     return stats;
   }
-  applyPreconditioner(r, z);
+  preconditioner_->apply(r, z);
   p = z;
   double rz = dot(r, z);
   for (int it = 1; it <= maxIterations; ++it) {
@@ -134,7 +101,7 @@ PressureSolveStats PressureSolver::solve(const Eigen::VectorXd& b, Eigen::Vector
         return stats;
       }
     }
-    applyPreconditioner(r, z);
+    preconditioner_->apply(r, z);
     const double rzNew = dot(r, z);
     p = z + (rzNew / rz) * p;
     rz = rzNew;

@@ -3,8 +3,8 @@
 /// Preconditioned conjugate gradients for the symmetric positive definite pressure Poisson matrix of the
 /// gas solver. Own loop (rather than Eigen::ConjugateGradient) for two reasons: the stopping test is on
 /// the residual relative to a flux scale given by the caller (not to |b|, which is ~0 in a steady
-/// state), and the incomplete-Cholesky factor may be reused while the matrix drifts (a factor of a
-/// nearby SPD matrix is still a valid preconditioner), so it is not refactored every step.
+/// state), and a preconditioner's factor may be reused while the matrix drifts (a factor of a nearby
+/// SPD matrix is still a valid preconditioner), so it is not refactored every step.
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -14,13 +14,28 @@
 #include <vector>
 
 #include "cfddem/gas/AggregationMultigrid.hpp"
+#include "core/Registry.hpp"
 
 namespace rcfd::gas {
 
-enum class Preconditioner { IncompleteCholesky, Jacobi, Multigrid };
+/// A preconditioner M of the pressure CG, selected by the scene's gas.pressure_preconditioner:
+/// "mg", "ic" and "jacobi" (PressurePreconditioners.cpp; docs/gas.md, "Pressure solver choice").
+class PressurePreconditioner {
+ public:
+  using Matrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  virtual ~PressurePreconditioner() = default;
+  /// True if what build() computes stays a valid preconditioner while the matrix drifts: PressureSolver
+  /// then rebuilds it only every refactorInterval new matrices; false: at every new matrix.
+  virtual bool reusable() const = 0;
+  /// The grid cell (i, j, k) of every unknown, before the first build(); geometric methods use them.
+  virtual void setCells(const std::vector<std::array<int, 3>>& /*cellOf*/) {}
+  /// Builds M for the matrix A.
+  virtual void build(const Matrix& a) = 0;
+  /// z = M^-1 r.
+  virtual void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const = 0;
+};
 
-/// Parses "ic", "jacobi" or "mg"; throws std::invalid_argument otherwise.
-Preconditioner parsePreconditioner(const std::string& name);
+using PreconditionerRegistry = Registry<PressurePreconditioner>;
 
 struct PressureSolveStats {
   int iterations = 0;
@@ -32,7 +47,7 @@ class PressureSolver {
  public:
   using Matrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
-  explicit PressureSolver(Preconditioner kind, int refactorInterval = 20);
+  explicit PressureSolver(std::unique_ptr<PressurePreconditioner> preconditioner, int refactorInterval = 20);
   ~PressureSolver();
 
   /// Takes a new matrix (same sparsity pattern from step to step). The preconditioner is rebuilt when
@@ -48,17 +63,11 @@ class PressureSolver {
   void setCells(std::vector<std::array<int, 3>> cellOf);
 
  private:
-  void applyPreconditioner(const Eigen::VectorXd& r, Eigen::VectorXd& z) const;
-
-  Preconditioner kind_;
+  std::unique_ptr<PressurePreconditioner> preconditioner_;
+  bool built_ = false;
   int refactorInterval_;
   int sinceFactor_ = 0;
   Matrix a_;
-  Eigen::VectorXd inverseDiagonal_;
-  struct IcHolder;
-  std::unique_ptr<IcHolder> ic_;
-  std::vector<std::array<int, 3>> cells_;
-  std::unique_ptr<AggregationMultigrid> mg_;
 };
 
 }  // namespace rcfd::gas

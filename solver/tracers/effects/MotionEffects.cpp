@@ -2,9 +2,9 @@
 // transport (Eq. 9), fluctuation (Eq. 10), free_flight and walls.
 #include <memory>
 
-#include "core/Errors.hpp"
 #include "tracers/FluctuationModel.hpp"
 #include "tracers/TracerEffect.hpp"
+#include "tracers/TracerIntegrator.hpp"
 
 namespace rcfd {
 namespace {
@@ -12,12 +12,8 @@ namespace {
 class TransportEffect final : public TracerEffect {
  public:
   explicit TransportEffect(const TracerContext& ctx)
-      : maxCourant_(ctx.scene.rcfd.max_courant), midpoint_(ctx.scene.rcfd.integrator != "euler") {
-    if (ctx.scene.rcfd.integrator != "euler" && ctx.scene.rcfd.integrator != "midpoint") {
-      throw InputError("scene", "/rcfd/integrator",
-                       "unknown integrator \"" + ctx.scene.rcfd.integrator + "\"; valid: euler midpoint");
-    }
-  }
+      : maxCourant_(ctx.scene.rcfd.max_courant),
+        midpoint_(tracerIntegrator(ctx.scene) == TracerIntegrator::Midpoint) {}
   void configureMotion(MotionSettings& m) override {
     m.transport = true;
     m.maxCourant = maxCourant_;

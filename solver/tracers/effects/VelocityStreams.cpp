@@ -36,6 +36,7 @@
 #include "tracers/CounterRng.hpp"
 #include "tracers/Trilinear.hpp"
 #include "tracers/TracerEffect.hpp"
+#include "tracers/TracerIntegrator.hpp"
 
 namespace rcfd {
 namespace {
@@ -52,7 +53,7 @@ class VelocityStreamsEffect final : public TracerEffect {
     up_.assign(n, 0);
     for (auto& v : ctx.streamVelocity) v.assign(n, 0.0f);
     upCount_.assign(std::size_t(ctx.grid.cellCount()), 0);
-    midpoint_ = ctx.scene.rcfd.integrator != "euler";
+    midpoint_ = tracerIntegrator(ctx.scene) == TracerIntegrator::Midpoint;
   }
 
   std::size_t allocatedBytes() const override {
