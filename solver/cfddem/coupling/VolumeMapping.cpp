@@ -200,18 +200,23 @@ VolumeMapping::VelocitySpread VolumeMapping::velocitySpread(const DemParticles& 
   s.variance.assign(cells, Eigen::Vector3d::Zero());
   s.upFraction.assign(cells, 0.0);
   std::vector<double> volume(cells, 0.0), upVolume(cells, 0.0), downVolume(cells, 0.0);
-  // Serial scatter in index order, as meanVelocity(): deterministic sums. The variance is summed about
-  // the known mean (no cancellation of two large sums).
+  // Serial scatter in index order, as meanVelocity(): deterministic sums. The variance is taken about
+  // the mean interpolated to each parcel with its own weights, not about the cell's mean: tracers move
+  // with u_P^rec interpolated to their position, so the part of the spread that is the mean's variation
+  // across the kernel (shear across a wall layer or a spout's edge) they already have, and counting it
+  // again as a random fluctuation would spread them across that edge. What is left is what the
+  // interpolated mean loses (law of total variance at the parcels' positions).
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double v = parcelVolume(p, i);
     const bool up = p.v[i].y() > 0.0;
+    const Eigen::Vector3d meanHere = interpolate(s.mean, w[i]);
     for (int k = 0; k < w[i].count; ++k) {
       const std::size_t c = std::size_t(w[i].cell[std::size_t(k)]);
       const double wv = w[i].w[std::size_t(k)] * v;
       volume[c] += wv;
       (up ? s.up[c] : s.down[c]) += wv * p.v[i];
       (up ? upVolume[c] : downVolume[c]) += wv;
-      s.variance[c] += wv * (p.v[i] - s.mean[c]).cwiseAbs2();
+      s.variance[c] += wv * (p.v[i] - meanHere).cwiseAbs2();
     }
   }
   for (std::size_t c = 0; c < cells; ++c) {

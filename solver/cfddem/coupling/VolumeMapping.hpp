@@ -65,7 +65,8 @@ class VolumeMapping {
   /// What the mean velocity of a cell's particle volume leaves out, with the weights of meanVelocity():
   /// the share of the volume moving up (v_y > 0), the mean velocity of the upward and of the other
   /// volume (the cell's mean where a part holds no volume, zero in an empty cell), and the variance of
-  /// each velocity component about the mean. upFraction u_up + (1 - upFraction) u_down = mean to
+  /// each velocity component about the mean interpolated to each parcel with its weights (so a linear
+  /// shear across the kernel adds nothing). upFraction u_up + (1 - upFraction) u_down = mean to
   /// round-off.
   struct VelocitySpread {
     std::vector<Eigen::Vector3d> mean, up, down, variance;
