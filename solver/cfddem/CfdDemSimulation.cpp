@@ -17,6 +17,9 @@
 
 namespace rcfd {
 
+/// Gas steps beyond the planned ones that one coupling step may take when the gas speeds up within it.
+constexpr int kMaxExtraGasSteps = 100000;
+
 struct CfdDemSimulation::Coupling {
   std::unique_ptr<coupling::FluidCoupling> fluid;     ///< with gas
   std::unique_ptr<coupling::VolumeMapping> mapping;   ///< without gas: alpha_P and u_P on demand
@@ -61,6 +64,7 @@ FillResult CfdDemSimulation::fillAndSettle(const std::function<bool()>& stopRequ
   options.stop_requested = stopRequested;
   options.stage_started = stageStarted;
   options.max_settle_time = scene_.dem.settle_time;
+  options.inside = [this](const Eigen::Vector3d& x) { return apparatus_->signedDistance(x) > 0.0; };
   const FillResult r = rcfd::fillAndSettle(*dem_, defaultFillRegion(scene_.apparatus), parcelsForBedMass(scene_), options);
   demStep_ = dem_->steps();
   lastInterval_ = 0.0;  // the gas starts from here: no rate of change of alpha_G yet
@@ -91,16 +95,38 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
     k = std::max<std::int64_t>(1, std::min(k, kCfl));
     const double dt = double(k) * dtDem;
     const int gasSteps = std::max(1, int(std::ceil(dt / stable * (1.0 - 1e-12))));
-    for (int s = 0; s < gasSteps; ++s) {
-      const double h = dt / gasSteps;
-      const double taken = gas_->step(h);
-      if (taken < h * (1.0 - 1e-12)) {
+    // One gas step of at most h; a failure of the gas's own (the residual, a non-finite velocity) is
+    // reported with when it happened.
+    auto gasStep = [&](double h) {
+      double taken = 0.0;
+      try {
+        taken = gas_->step(h);
+      } catch (const RunError& e) {
         std::ostringstream m;
-        m << "CFD-DEM: the gas step was limited to " << taken << " s below the planned " << h << " s at t = "
-          << time() << " s (the gas velocity grew within one coupling step)";
+        m << "CFD-DEM at t = " << time() << " s (DEM step " << demStep_ << ", gas step of " << h << " s): " << e.what();
         throw RunError(m.str());
       }
       last_.pressureIterations += gas_->lastStep().pressureIterations;
+      return taken;
+    };
+    double left = dt;  // of the coupling step still to cover with gas steps
+    for (int s = 0; s < gasSteps; ++s) {
+      const double h = dt / gasSteps;
+      const double taken = gasStep(h);
+      left -= taken;
+      if (taken < h * (1.0 - 1e-12)) break;  // the gas velocity grew within the coupling step: see below
+      left = dt - double(s + 1) * h;
+    }
+    // A CFL limit that fell within the coupling step (the gas sped up) is met by further, shorter gas
+    // steps until the step's time is covered; the DEM side is unchanged.
+    for (int extra = 0; left > 1e-12 * dt; ++extra) {
+      if (extra >= kMaxExtraGasSteps) {
+        std::ostringstream m;
+        m << "CFD-DEM: the gas step fell below " << dt / kMaxExtraGasSteps << " s at t = " << time()
+          << " s (DEM step " << demStep_ << "): the gas velocity grows without bound";
+        throw RunError(m.str());
+      }
+      left -= gasStep(left);
     }
     coupling_->fluid->applyForces();
     last_.courant = gas_->lastStep().courant;
@@ -117,13 +143,29 @@ const CfdDemStepStats& CfdDemSimulation::step(std::int64_t untilDemStep) {
 
 void CfdDemSimulation::checkParcels() const {
   const DemParticles& p = dem_->particles();
-  for (std::size_t i = 0; i < p.size(); ++i)
+  const Eigen::Vector3d lower = apparatus_->lowerCorner(), upper = apparatus_->upperCorner();
+  for (std::size_t i = 0; i < p.size(); ++i) {
     if (!p.x[i].allFinite() || !p.v[i].allFinite()) {
       std::ostringstream m;
       m << "CFD-DEM: parcel " << p.id[i] << " has a non-finite position or velocity at t = " << time()
         << " s (DEM step " << demStep_ << "), at x = (" << p.x[i].transpose() << ")";
       throw RunError(m.str());
     }
+    // A parcel whose centre left the chamber's bounding box passed a wall within one DEM step: it moved
+    // so far per step that its wall contact was never resolved. The scene's DEM step is too long for the
+    // speeds the gas gives the parcels (the Rayleigh criterion bounds the contact stiffness, not the
+    // speed).
+    if (((p.x[i] - lower).array() < 0.0).any() || ((upper - p.x[i]).array() < 0.0).any()) {
+      const double dt = dem_->timeStep(), speed = p.v[i].norm(), r = p.radius[i];
+      std::ostringstream m;
+      m.precision(3);
+      m << "parcel " << p.id[i] << " left the chamber at t = " << time() << " s (DEM step " << demStep_
+        << ") moving at " << speed << " m/s: " << dt << " s moves it " << speed * dt / r
+        << " radii a step, too far for its wall contacts; at most " << (speed > 0.0 ? 0.5 * r / speed : dt)
+        << " s (half a radius a step at that speed) keeps them resolved";
+      throw InputError("scene", "/dem/time_step", m.str());
+    }
+  }
 }
 
 std::int64_t CfdDemSimulation::demStep() const { return demStep_; }

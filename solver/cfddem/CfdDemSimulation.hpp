@@ -106,7 +106,8 @@ class CfdDemSimulation {
 
  private:
   struct Coupling;  // volume mapping, drag, exchange (cfddem/coupling/)
-  /// RunError naming the first parcel with a non-finite position or velocity.
+  /// RunError naming the first parcel with a non-finite position or velocity; InputError naming
+  /// /dem/time_step for a parcel outside the chamber's bounding box (a DEM step too long for its speed).
   void checkParcels() const;
 
   const Scene& scene_;

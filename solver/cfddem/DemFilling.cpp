@@ -25,9 +25,14 @@ FillRegion defaultFillRegion(const ApparatusSpec& a) {
   if (a.type == ApparatusSpec::Type::Box) {
     r.lower = Vector3d(-0.5 * a.size.x(), 2.0 / 3.0 * a.size.y(), 0.0);
     r.upper = Vector3d(0.5 * a.size.x(), a.size.y(), a.size.z());
-  } else {
+  } else if (a.height >= 0.3) {
     r.lower = Vector3d(-0.5 * a.width, 0.2, 0.0);
-    r.upper = Vector3d(0.5 * a.width, std::min(0.3, a.height), a.depth);
+    r.upper = Vector3d(0.5 * a.width, 0.3, a.depth);
+  } else {
+    // A chamber lower than the paper's region: its upper third, and above the top of the V-bottom.
+    const double vTop = 0.5 * (a.width - a.inlet_width) * std::tan(a.prism_angle_deg * std::numbers::pi / 180.0);
+    r.lower = Vector3d(-0.5 * a.width, std::max(2.0 / 3.0 * a.height, vTop), 0.0);
+    r.upper = Vector3d(0.5 * a.width, a.height, a.depth);
   }
   return r;
 }
@@ -119,8 +124,9 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
   while (result.inserted < count) {
     if (result.batches >= o.max_batches)
       throw RunError("DEM filling: " + std::to_string(count - result.inserted) + " of " +
-                     std::to_string(count) + " parcels found no room after " +
-                     std::to_string(o.max_batches) + " batches; enlarge the insertion region");
+                     std::to_string(count) + " parcels found no room after " + std::to_string(o.max_batches) +
+                     " batches: the bed does not pour into the chamber below the filling region (a smaller "
+                     "/process/bed_mass fits; docs/dem.md)");
     ++result.batches;
     Occupancy occ{2.0 * r, {}};
     const DemParticles& p = dem.particles();
@@ -134,7 +140,7 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
     for (long attempts = 1; result.inserted < count && misses < max_misses; ++attempts) {
       if (attempts % kInsertionAttemptsPerPoll == 0) throwIfStopRequested(dem, o.stop_requested);
       const Vector3d x = lo + (hi - lo).cwiseProduct(Vector3d(u(rng), u(rng), u(rng)));
-      if (dem.walls().clearance(x) < 1.01 * r || !occ.free(x, gap)) {
+      if (dem.walls().clearance(x) < 1.01 * r || (o.inside && !o.inside(x)) || !occ.free(x, gap)) {
         ++misses;
         continue;
       }

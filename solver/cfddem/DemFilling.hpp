@@ -39,6 +39,10 @@ struct FillOptions {
   std::function<bool()> stop_requested;
   /// Called as the filling enters each stage (the job's progress names it). Empty: not called.
   std::function<void(FillStage)> stage_started;
+  /// A new parcel's centre must also lie inside the open region by this test (the apparatus's signed
+  /// distance > 0): the walls' clearance is a distance, the same in front of a wall and behind it, and
+  /// a region that reaches behind a steep V-bottom would otherwise take parcels there. Empty: any.
+  std::function<bool(const Eigen::Vector3d&)> inside;
 };
 
 struct FillResult {
@@ -54,7 +58,8 @@ struct FillResult {
 long parcelsForBedMass(const Scene& scene);
 
 /// The paper's insertion region for the prismatic spouted bed, 0.2 m < y < 0.3 m over the chamber's
-/// width and depth; for a box, the upper third.
+/// width and depth (a chamber lower than 0.3 m: its upper third, above the V-bottom's top); for a box,
+/// the upper third.
 FillRegion defaultFillRegion(const ApparatusSpec& apparatus);
 
 /// Inserts `count` parcels in `region` (clear of walls and of each other), lets them fall and settles.

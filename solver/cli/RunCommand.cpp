@@ -22,6 +22,7 @@ const bool registered = rcfd::cli::addCommand(
         bool progressJson = false;
         int threads = 0;
         long stopAfter = -1;
+        int maxPressureIterations = 0;
         double cancelDeadline = kDefaultCancelDeadlineSeconds;
       };
       auto args = std::make_shared<Args>();
@@ -38,6 +39,9 @@ const bool registered = rcfd::cli::addCommand(
       app.add_option("--stop-after-steps", args->stopAfter,
                      "testing: checkpoint and exit 130 after this many steps")
           ->group("");
+      app.add_option("--max-pressure-iterations", args->maxPressureIterations,
+                     "testing: cap the gas pressure solver's iterations per step (a solve that does not converge)")
+          ->group("");
       return [args] {
         if (args->threads > 0) omp_set_num_threads(args->threads);
         rcfd::installCancellationHandlers();
@@ -47,6 +51,7 @@ const bool registered = rcfd::cli::addCommand(
         options.outDir = args->out;
         options.progressJson = args->progressJson;
         options.stopAfterSteps = args->stopAfter;
+        options.maxPressureIterations = args->maxPressureIterations;
         const auto summary = rcfd::runJob(job, options);
         std::cerr << "done: " << args->out << "/summary.json (" << summary.value("wall_time_s", 0.0)
                   << " s)\n";

@@ -120,6 +120,24 @@ void checkFrame(const FieldFrame& frame, int index, const CartesianGrid& grid, c
                                         "; every value must be finite"});
     }
   }
+  if (violations.empty()) {
+    // alpha_P is a volume fraction: in [0, 1]. A branch-free scan (it vectorises); only a bad frame pays
+    // for the search of the cell.
+    const std::vector<float>& alpha = frame.alpha_p;
+    float lo = 0.0f, hi = 1.0f;
+    for (const float a : alpha) lo = std::min(lo, a), hi = std::max(hi, a);
+    if (lo < 0.0f || hi > 1.0f) {
+      for (std::size_t c = 0; c < alpha.size(); ++c) {
+        if (alpha[c] >= 0.0f && alpha[c] <= 1.0f) continue;
+        const auto ijk = grid.cellIjk(std::int64_t(c));
+        violations.push_back({"/frames/alpha_p", "frame " + std::to_string(index) + ", cell (" + std::to_string(ijk[0]) +
+                                                     ", " + std::to_string(ijk[1]) + ", " + std::to_string(ijk[2]) +
+                                                     ") holds " + str(alpha[c]) +
+                                                     "; a volume fraction must be in [0, 1]"});
+        break;
+      }
+    }
+  }
   if (spread && violations.empty()) {
     // Shares in [0, 1] and variances >= 0, within float rounding of the writer's arithmetic.
     auto firstOutside = [](const std::vector<float>& values, float lo, float hi) -> std::int64_t {

@@ -21,7 +21,7 @@ void validateFluidFraction(const std::vector<float>& fluidFraction, const Cartes
 void validateDtRec(double dtRec, std::vector<Violation>& violations);
 
 /// Throws rcfd::InputError (source `source`) if frame `index` has the wrong sizes for `grid` or holds
-/// a NaN or infinity; the message names the dataset, the frame and the cell (i, j, k).
+/// a NaN or infinity, or an alpha_P outside [0, 1]; the message names the dataset, the frame and the cell (i, j, k).
 void checkFrame(const FieldFrame& frame, int index, const CartesianGrid& grid, const std::string& source);
 
 }  // namespace rcfd

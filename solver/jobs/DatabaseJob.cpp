@@ -27,6 +27,7 @@
 
 #include "analysis/DatabaseFigures.hpp"
 #include "cfddem/CfdDemSimulation.hpp"
+#include "cfddem/gas/GasSolver.hpp"
 #include "scene/DatabaseSchedule.hpp"
 #include "cfddem/ReferenceRecorder.hpp"
 #include "core/Errors.hpp"
@@ -121,7 +122,9 @@ class DatabaseJob final : public JobRunner {
     const std::string checkpoint = options.outDir + "/checkpoint.h5";
     const std::string databasePath = options.outDir + "/database.h5";
 
-    CfdDemSimulation sim(scene, job.seed);
+    gas::GasOptions gasOptions;
+    if (options.maxPressureIterations > 0) gasOptions.maxPressureIterations = options.maxPressureIterations;
+    CfdDemSimulation sim(scene, job.seed, gasOptions);
     const std::vector<double> open = openFractions(sim.apparatus(), sim.grid());
     const std::vector<float> fluid(open.begin(), open.end());
     if (cancellationRequested()) throw Cancelled("stopped while setting up the simulation; nothing was written");
@@ -251,7 +254,12 @@ class DatabaseJob final : public JobRunner {
                        std::to_string(st.settledStep + next) + ")");
       }
       if (sim.hasGas()) sim.setFlowFactor(plan.flowFactor(offset));
-      sim.step(st.settledStep + next);
+      try {
+        sim.step(st.settledStep + next);
+      } catch (const RunError& e) {  // a failed step keeps the last checkpoint: say which
+        throw RunError(std::string(e.what()) + "; the checkpoint of t = " +
+                       std::to_string(double(lastCheckpoint) * plan.dtDem) + " s is kept in " + checkpoint);
+      }
       ++st.couplingSteps;
       const bool stopForTest =
           options.stopAfterSteps >= 0 && st.couplingSteps - firstCouplingStep >= options.stopAfterSteps;

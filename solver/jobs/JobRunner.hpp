@@ -19,6 +19,9 @@ struct RunOptions {
   bool progressJson = false;   ///< JSON progress lines on stdout
   double progressInterval = 1.0;  ///< [s] of wall time between progress reports
   long stopAfterSteps = -1;    ///< testing: behave as if cancelled after this many steps (-1: never)
+  /// testing: at most this many pressure-solver iterations per gas step of a database job (0: the gas
+  /// solver's own limit), to make a gas solve fail as one that does not converge would
+  int maxPressureIterations = 0;
 };
 
 class JobRunner {

@@ -40,7 +40,8 @@ class MarkovPathGenerator final : public PathGenerator {
       if (e - window - 1 < 0 && e + window + 1 > n - 2) {
         throw InputError("scene", "/rcfd/path/correlation_window",
                          std::to_string(window) + " frames leaves frame " + std::to_string(e) +
-                             " no jump target in a database of " + std::to_string(n) + " frames");
+                             " no jump target in a database of " + std::to_string(n) + " frames; at most " +
+                             std::to_string(std::max(0, (n - 3) / 2)) + " frames allowed here");
       }
     }
     const double meanLength = n * 0.5 * (spec_.min_sequence_fraction + spec_.max_sequence_fraction);

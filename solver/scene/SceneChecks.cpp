@@ -1,5 +1,6 @@
 #include "scene/SceneChecks.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -7,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "cfddem/DemFilling.hpp"
+#include "cfddem/DemMaterial.hpp"
 #include "scene/DatabaseSchedule.hpp"
 #include "scene/SchemaExplainer.hpp"
 
@@ -104,13 +107,20 @@ void checkApparatus(const ApparatusSpec& a, std::vector<Violation>& out) {
   }
 }
 
-/// Open volume of the chamber [m3]: the box, or the prism's cross-section (width x height less the
-/// V-bottom's two wedges and the draft plates) times its depth.
-double chamberOpenVolume(const ApparatusSpec& a) {
-  if (a.type == ApparatusSpec::Type::Box) return a.size.x() * a.size.y() * a.size.z();
-  const double vTop = 0.5 * (a.width - a.inlet_width) * tanDeg(a.prism_angle_deg);
-  double area = a.width * a.height - 0.5 * (a.width - a.inlet_width) * vTop;
-  if (a.draft_plates) area -= 2.0 * a.draft_plates->thickness * a.draft_plates->height;
+/// Open volume of the chamber below the height y [m3]: the box's, or the prism's cross-section up to y
+/// (the V-bottom's slot widening by 2 / tan(angle) per metre up to its top, the full width above, less
+/// the draft plates) times its depth.
+double openVolumeBelow(const ApparatusSpec& a, double y) {
+  if (a.type == ApparatusSpec::Type::Box) return a.size.x() * a.size.z() * std::clamp(y, 0.0, a.size.y());
+  y = std::clamp(y, 0.0, a.height);
+  const double tanA = tanDeg(a.prism_angle_deg);
+  const double vTop = 0.5 * (a.width - a.inlet_width) * tanA;
+  const double inV = std::min(y, vTop);
+  double area = a.inlet_width * inV + inV * inV / tanA + a.width * std::max(0.0, y - vTop);
+  if (a.draft_plates) {
+    const auto& p = *a.draft_plates;
+    area -= 2.0 * p.thickness * std::max(0.0, std::min(y, p.elevation + p.height) - p.elevation);
+  }
   return std::max(0.0, area) * a.depth;
 }
 
@@ -128,16 +138,43 @@ void apparatusBounds(const ApparatusSpec& a, Vec3& lower, Vec3& upper) {
 
 std::vector<Violation> checkDatabaseScene(const Scene& s) {
   std::vector<Violation> out;
-  // A bed that cannot fit the chamber even packed as densely as a random packing gets (0.64) is refused
-  // before the job starts: the DEM fill would otherwise try to insert it for as long as it runs.
-  constexpr double kDensestRandomPacking = 0.64;
-  const double chamber = chamberOpenVolume(s.apparatus);
-  const double packed = s.process.bed_mass / (kDensestRandomPacking * s.particles.density);
-  if (packed > chamber) {
-    out.push_back({"/process/bed_mass", num(s.process.bed_mass) + " kg packs (alpha_P " + num(kDensestRandomPacking) +
-                                            ") into " + num(packed) + " m3, more than the chamber's open volume " +
-                                            num(chamber) + " m3: at most " +
-                                            num(chamber * kDensestRandomPacking * s.particles.density) + " kg fits"});
+  // The filling pours the bed from its region (defaultFillRegion) into the chamber below it: a bed that
+  // does not fit there, poured as loosely as a bed packs (alpha_P 0.5; a slice a few parcels deep packs
+  // no denser), would bury the region and the filling would try for as long as it runs. Refused before
+  // the job starts.
+  constexpr double kPouredPacking = 0.5;
+  const FillRegion region = defaultFillRegion(s.apparatus);
+  const double regionBottom = region.lower.y();
+  // Parcels are inserted whole, clear of the region's walls: it must be wider, higher and deeper than one.
+  const double parcel = s.dem.coarse_graining * s.particles.diameter;
+  const Vec3 regionSize = region.upper - region.lower;
+  if (regionSize.minCoeff() <= 1.02 * parcel) {
+    out.push_back({"/particles/diameter", "a parcel of coarse_graining x diameter = " + num(parcel) +
+                                              " m does not fit the region the bed is poured from (" +
+                                              num(regionSize.x()) + " x " + num(regionSize.y()) + " x " +
+                                              num(regionSize.z()) + " m, y from " + num(region.lower.y()) +
+                                              " m): at most " + num(regionSize.minCoeff() / 1.02) + " m"});
+  }
+  const double below = openVolumeBelow(s.apparatus, regionBottom);
+  const double poured = s.process.bed_mass / (kPouredPacking * s.particles.density);
+  if (poured > below) {
+    out.push_back({"/process/bed_mass", num(s.process.bed_mass) + " kg poured (alpha_P " + num(kPouredPacking) +
+                                            ") fills " + num(poured) + " m3, more than the chamber's open volume below " +
+                                            "the filling region (y < " + num(regionBottom) + " m), " + num(below) +
+                                            " m3: at most " + num(below * kPouredPacking * s.particles.density) +
+                                            " kg fits"});
+  }
+  // The gas enters through the prism's inlet slot; a box has walls all round (GasSolver refuses it).
+  if (s.apparatus.type == ApparatusSpec::Type::Box && s.hasEffect("gas")) {
+    const auto at = std::find(s.effects.begin(), s.effects.end(), "gas") - s.effects.begin();
+    out.push_back({"/effects/" + std::to_string(at), "the gas needs an inlet: a box's bottom is a wall, the effect gas "
+                                                     "needs the inlet slot of a prismatic_spouted_bed"});
+  }
+  // The DEM time step against the Rayleigh time of the parcels (the job would refuse it at start).
+  try {
+    checkTimeStep(DemMaterial::fromScene(s), s.dem.time_step, s.dem.max_rayleigh_fraction);
+  } catch (const InputError& e) {
+    for (const auto& v : e.violations()) out.push_back(v);
   }
   for (auto& v : DatabaseSchedule::violations(s)) out.push_back(std::move(v));
   return out;
@@ -204,6 +241,26 @@ std::vector<Violation> checkSceneSemantics(const Scene& s, const json& document)
     }
     if (zone.y_max > upper.y()) {
       out.push_back({"/spray/spray_zone/y_max", num(zone.y_max) + " is above the apparatus top y = " + num(upper.y())});
+    }
+  }
+  if (s.hasEffect("spray")) {
+    const auto& sp = s.spray;
+    // Eq. (15): a droplet covers f = (d_D / 2 d_P)^2 of its particle; the deposition on particles as
+    // spots needs droplets smaller than the particles (f < 1/4).
+    if (!(sp.droplet_diameter < s.particles.diameter)) {
+      out.push_back({"/spray/droplet_diameter", num(sp.droplet_diameter) +
+                                                    " m is not smaller than the particle diameter /particles/diameter = " +
+                                                    num(s.particles.diameter) + " m (Eq. 15 covers particles with droplet spots)"});
+    }
+    // A parcel carries at least one droplet (N_D,min = 1): with fewer, every parcel would be dropped
+    // as residual at once and nothing deposit.
+    const double dropletMass = sp.droplet_density * std::numbers::pi / 6.0 * std::pow(sp.droplet_diameter, 3);
+    const double dropletRate = sp.mass_rate / dropletMass;
+    if (sp.parcels_per_s > dropletRate) {
+      out.push_back({"/spray/parcels_per_s", num(sp.parcels_per_s) + " parcels/s would carry " +
+                                                 num(dropletRate / sp.parcels_per_s) +
+                                                 " droplets each; every parcel needs at least one: at most " +
+                                                 num(dropletRate) + " parcels/s (mass_rate / droplet mass)"});
     }
   }
 

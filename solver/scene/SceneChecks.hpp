@@ -25,8 +25,8 @@ inline constexpr std::size_t kMaxArrayItems = 100000;
 std::vector<Violation> documentLimitViolations(const nlohmann::json& document);
 
 /// Rules a scene must meet to be simulated by the CFD-DEM of a database job (pointers into the scene):
-/// the bed fits the chamber, and the frames and reference samples fall on whole DEM steps
-/// (DatabaseSchedule).
+/// the bed fits the chamber, the DEM time step is within dem.max_rayleigh_fraction of the Rayleigh time,
+/// and the frames and reference samples fall on whole DEM steps (DatabaseSchedule).
 std::vector<Violation> checkDatabaseScene(const Scene& scene);
 
 /// Lower and upper corner of the apparatus's bounding box (docs/contracts.md, "Coordinates") [m].

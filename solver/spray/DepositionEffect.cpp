@@ -31,6 +31,9 @@ namespace {
 
 constexpr std::int64_t kPicksPerBinomial = 32;  ///< see DepositionEffect::distribute
 constexpr std::int64_t kScanBlock = 256;        ///< tracers tested together in DepositionEffect::handOut
+/// Whole droplets one cell hands out in one step at most: 2^53, below which whole numbers are exact in
+/// double (and far inside int64). Reached only by droplets of a fraction of a micrometre.
+constexpr double kMaxDropletsPerHandOut = 9007199254740992.0;
 
 class DepositionEffect final : public TracerEffect, public ParcelDeposition {
  public:
@@ -56,7 +59,7 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
   std::size_t allocatedBytes() const override {
     return (state_->cellDeposit.capacity() + state_->cellPending.capacity() + state_->tracerDroplets.capacity()) *
                sizeof(double) +
-           (due_.capacity() + slot_.capacity() + dueBits_.capacity()) * sizeof(std::int32_t);
+           due_.capacity() * sizeof(std::int64_t) + (slot_.capacity() + dueBits_.capacity()) * sizeof(std::int32_t);
   }
 
   bool afterMoveBesideMotion() const override { return true; }
@@ -119,20 +122,22 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
 
   void handOut(TracerContext& ctx) {
     auto& s = *state_;
-    // Whole droplets due per touched cell; the fraction waits.
-    std::int64_t dueTotal = 0;
+    // Whole droplets due per touched cell; the fraction waits. Tiny droplets deposit billions a cell and
+    // step (64-bit counts); at most kMaxDropletsPerHandOut, whole numbers exact in double, go out in one
+    // step, and anything beyond waits in the cell like the fraction (still in the books as pending).
+    bool anyDue = false;
     for (const std::int32_t c : touched_) {
       const double total = s.cellPending[std::size_t(c)] + s.cellDeposit[std::size_t(c)];
-      const double whole = ctx.tracerCount[std::size_t(c)] > 0 ? std::floor(total) : 0.0;
-      due_[std::size_t(c)] = std::int32_t(whole);
+      const double whole = ctx.tracerCount[std::size_t(c)] > 0 ? std::min(std::floor(total), kMaxDropletsPerHandOut) : 0.0;
+      due_[std::size_t(c)] = std::int64_t(whole);
       s.cellPending[std::size_t(c)] = total - whole;
-      dueTotal += std::int64_t(whole);
+      anyDue = anyDue || whole > 0.0;
     }
     waiting_.clear();
     for (const std::int32_t c : touched_) {
       if (s.cellPending[std::size_t(c)] > 0.0) waiting_.push_back(c);
     }
-    if (dueTotal == 0) return;
+    if (!anyDue) return;
     // The cells with droplets due, in cell order, each a slot; then their tracers grouped by slot, in
     // tracer order within a slot: one pass over all tracers in contiguous ranges (in parallel), the
     // few members of each range kept in range order, then a stable counting sort by slot. The order
@@ -197,7 +202,7 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
       const std::int32_t c = slotCells_[k];
       slot_[std::size_t(c)] = -1;
       CounterRng rng(ctx.seed, RngPurpose::Deposition, std::uint64_t(c), std::uint64_t(ctx.step));
-      distribute(rng, std::int64_t(due_[std::size_t(c)]), std::size_t(slotStart_[k]), std::size_t(slotStart_[k + 1]),
+      distribute(rng, due_[std::size_t(c)], std::size_t(slotStart_[k]), std::size_t(slotStart_[k + 1]),
                  s.tracerDroplets);
       assigned += double(due_[std::size_t(c)]);
       due_[std::size_t(c)] = 0;
@@ -254,7 +259,7 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
   const float* tracerAlpha_ = nullptr;
   std::optional<FrameSampler> frames_;
   std::optional<StepFieldSampler> gas_, particles_;
-  std::vector<std::int32_t> due_;       ///< whole droplets due per cell this step
+  std::vector<std::int64_t> due_;       ///< whole droplets due per cell this step
   std::vector<std::int32_t> touched_;   ///< cells with new or pending droplets this step
   std::vector<std::int32_t> waiting_;   ///< cells keeping a fraction of a droplet
   std::vector<std::int32_t> members_;     ///< tracers of the cells with droplets due, grouped by cell

@@ -149,7 +149,7 @@ TEST(GasProCell, BoxWithoutOutletRefused) {
     FAIL() << "accepted";
   } catch (const InputError& e) {
     ASSERT_FALSE(e.violations().empty());
-    EXPECT_EQ(e.violations()[0].pointer, "/apparatus/box_outlet_top");
+    EXPECT_EQ(e.violations()[0].pointer, "/apparatus/outlet_top");  // the scene key, not the C++ member
   }
 }
 

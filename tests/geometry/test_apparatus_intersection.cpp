@@ -11,6 +11,7 @@
 
 #include "GeometryFixtures.hpp"
 #include "geometry/Apparatus.hpp"
+#include "../SanitizedBuild.hpp"
 
 namespace rcfd {
 namespace {
@@ -331,7 +332,9 @@ TEST(ApparatusIntersection, Throughput) {
   const double dt2 = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   std::printf("signedDistance:    %.1f M points/s on one thread (checksum %.3f)\n",
               5.0 * segs.size() / dt2 / 1e6, sum);
-  EXPECT_GT(rate, 5e5);  // generous: the machine is shared; see docs/geometry.md for measured rates
+  if (!test::kSanitizedBuild) {
+    EXPECT_GT(rate, 5e5);  // generous: the machine is shared; see docs/geometry.md for measured rates
+  }
 }
 
 }  // namespace

@@ -134,7 +134,8 @@ TEST(Jobs, ScenePatchThatBreaksTheSceneIsRefusedWithItsPointer) {
 }
 
 TEST(Jobs, ADatabaseJobWhoseBedCannotFitTheChamberIsRefusedBeforeItStarts) {
-  // The quick slice's chamber holds 2.54e-3 m3: at most 1.69 kg of its particles packed at 0.64.
+  // The quick slice is filled from its region 0.2 m < y < 0.3 m: below it the chamber holds 5.42e-4 m3,
+  // at most 0.28 kg of its particles poured at alpha_P 0.5 (the bed is 0.15 kg).
   json scene = quickScene();
   scene["process"]["bed_mass"] = 1e12;
   try {
@@ -143,11 +144,11 @@ TEST(Jobs, ADatabaseJobWhoseBedCannotFitTheChamberIsRefusedBeforeItStarts) {
   } catch (const InputError& e) {
     ASSERT_EQ(e.violations().size(), 1u) << e.what();
     EXPECT_EQ(e.violations()[0].pointer, "/scene/process/bed_mass");
-    EXPECT_NE(e.violations()[0].message.find("at most 1.69"), std::string::npos) << e.what();
+    EXPECT_NE(e.violations()[0].message.find("at most 0.28"), std::string::npos) << e.what();
   }
-  scene["process"]["bed_mass"] = 1.6;  // fits, packed
+  scene["process"]["bed_mass"] = 0.27;  // fits, poured
   EXPECT_NO_THROW(loadJob({{"kind", "database"}, {"scene", scene}}, "job"));
-  scene["process"]["bed_mass"] = 1.7;
+  scene["process"]["bed_mass"] = 0.29;
   EXPECT_THROW(loadJob({{"kind", "database"}, {"scene", scene}}, "job"), InputError);
   // Only the CFD-DEM fills the bed: a spray job on such a scene counts particles, nothing more.
   scene["process"]["bed_mass"] = 1e12;

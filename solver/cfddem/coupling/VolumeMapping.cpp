@@ -3,6 +3,7 @@
 #include "cfddem/coupling/VolumeMapping.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <cmath>
 #include <sstream>
 
@@ -99,8 +100,20 @@ bool VolumeMapping::reachable(const std::array<int, 3>& from, const std::array<i
 void VolumeMapping::weightsOf(const DemParticles& p, std::vector<KernelWeights>& out) const {
   out.resize(p.size());
   const long n = long(p.size());
+  // An exception must not leave an OpenMP region (std::terminate): the first parcel's failure (in
+  // parcel order, whatever the threads) is thrown after it.
+  long failed = n;
+  std::exception_ptr failure;
 #pragma omp parallel for schedule(static) if (n >= 4096)
-  for (long i = 0; i < n; ++i) out[std::size_t(i)] = weights(p.x[std::size_t(i)]);
+  for (long i = 0; i < n; ++i) {
+    try {
+      out[std::size_t(i)] = weights(p.x[std::size_t(i)]);
+    } catch (...) {
+#pragma omp critical(rcfd_volume_mapping_failure)
+      if (i < failed) failed = i, failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
 }
 
 void VolumeMapping::scatterVolume(const DemParticles& p, const std::vector<KernelWeights>& w,

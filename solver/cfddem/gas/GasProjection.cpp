@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <cstdio>
 #include <cstdlib>
 
@@ -84,10 +85,16 @@ void GasSolver::project(double dt, const std::array<std::vector<double>, 3>& dia
   for (int attempt = 0; attempt < 4; ++attempt) {
     const auto stats = pressureSolver_->solve(b, q_, absTol, options_.maxPressureIterations);
     last_.pressureIterations += stats.iterations;
-    if (!stats.converged)
-      throw RunError("gas solver: the pressure solver did not converge in " + std::to_string(stats.iterations) +
-                     " iterations (residual " + std::to_string(stats.residual / std::max(scale.norm(), 1e-300)) +
-                     " of the flux scale, tolerance /gas/pressure_tolerance = " + std::to_string(tol) + ")");
+    if (!stats.converged) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "gas solver: the pressure solver did not converge in " << stats.iterations << " iterations (relative residual "
+        << stats.residual / std::max(scale.norm(), 1e-300) << ", goal " << absTol / std::max(scale.norm(), 1e-300)
+        << " from the tolerance /gas/pressure_tolerance = " << tol
+        << "; a tolerance near the solver's round-off floor, which cells of a large aspect ratio raise, needs "
+           "loosening)";
+      throw RunError(m.str());
+    }
     u_ = predicted;
     correct(diag);
     last_.divergence = divergence();
@@ -218,16 +225,25 @@ DivergenceResidual GasSolver::divergence() const {
   for (const auto& [d, f] : inletFaces_) supply += std::abs(gasArea_[std::size_t(d)][f] * u_[std::size_t(d)][f]);
   DivergenceResidual out;
   double rr = 0.0, ss = 0.0, sum = 0.0;
+  std::size_t cells = 0;
   for (std::size_t c = 0; c < r.size(); ++c) {
     if (!active_[c]) continue;
+    ++cells;
     sum += r[c];
     rr += r[c] * r[c];
     ss += scale[c] * scale[c];
     out.maxAbs = std::max(out.maxAbs, std::abs(r[c]) / vol);
   }
-  out.relative = ss > 0 ? std::sqrt(rr / ss) : 0.0;
-  // Relative to the gas fed; without a feed (gas moved only by alpha_G), to what is stored.
-  const double netScale = supply > 0 ? supply : stored;
+  // Both measures are relative to the step's own fluxes, but never to less than a millionth of the
+  // scene's full gas flow: a gas at rest (no flow yet at the start of the ramp, no drag to stir it) has
+  // only round-off fluxes, whose residuals are as large as themselves.
+  const double least = 1e-6 * (scene_.process.gas_flow_rate + scene_.process.atomisation_flow_rate);
+  out.relative = ss > 0 ? std::sqrt(rr / std::max(ss, least * least)) : 0.0;
+  // Relative to the gas fed; without a feed (gas moved only by alpha_G), to what is stored; and never to
+  // less than the cells' root-mean-square flux: at the start of a ramp nothing is fed yet while the
+  // drag of moving parcels stirs the gas, and a balance relative to a feed of 0 cannot be met.
+  const double rmsCell = cells > 0 ? std::sqrt(ss / double(cells)) : 0.0;
+  const double netScale = std::max({supply > 0 ? supply : stored, least, rmsCell});
   out.net = netScale > 0 ? std::abs(sum) / netScale : 0.0;
   return out;
 }

@@ -80,8 +80,8 @@ void GasSolver::buildTopology() {
       }
     }
   if (stack.empty())
-    throw InputError("scene", box ? "/apparatus/box_outlet_top" : "/apparatus",
-                     "the gas solver needs an outlet at the top (box_outlet_top: true for a box)");
+    throw InputError("scene", box ? "/apparatus/outlet_top" : "/apparatus",
+                     "the gas solver needs an outlet at the top (outlet_top: true for a box)");
   while (!stack.empty()) {
     const std::size_t c = stack.back();
     stack.pop_back();
@@ -137,9 +137,11 @@ void GasSolver::buildTopology() {
   }
   const double q = scene_.process.gas_flow_rate;
   if (q > 0 && inletArea <= 0)
-    throw InputError("scene", "/process/gas_flow_rate",
-                     "a gas flow of " + std::to_string(q) + " m3/s needs an inlet, but the apparatus has none "
-                     "(a box has walls all round unless the solver's boxBottomInlet option is set)");
+    throw InputError("scene", box ? "/effects" : "/process/gas_flow_rate",
+                     "a gas flow of " + std::to_string(q) + " m3/s needs an inlet, but the apparatus has none" +
+                         std::string(box ? ": a box's bottom is a wall; the effect gas needs the inlet slot of a "
+                                           "prismatic_spouted_bed"
+                                         : ""));
   // The scene gives the flow through its own slot (a thin slice gives the slice's share): the
   // superficial inlet velocity is that flow over the slot area, inlet_width * depth.
   inletVelocity_ = inletArea > 0 ? q / inletArea : 0.0;

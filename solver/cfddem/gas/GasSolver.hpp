@@ -57,7 +57,8 @@ struct DivergenceResidual {
   double maxAbs = 0.0;    ///< max_c |r_c| / V_c [1/s]
   /// |sum_c r_c| / (inlet flow + nozzle flow): the domain's mass balance (what enters leaves or is
   /// stored) relative to the gas fed (sum_c V phi |dalpha/dt| without a feed), which a small |r|_2 does
-  /// not bound tightly [-]
+  /// not bound tightly; the scale is at least the cells' root-mean-square F_c and a millionth of the
+  /// scene's full flow (a feed of 0 at the start of a ramp) [-]
   double net = 0.0;
 };
 
