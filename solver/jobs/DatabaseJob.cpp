@@ -168,6 +168,7 @@ class DatabaseJob final : public JobRunner {
 
     if (!st.settled) {
       progress.setPhase("fill");
+      progress.setPhaseFraction(0.0);
       progress.report(0.0, sim.time(), true);
       // A stop request during the filling ends the job without a checkpoint (Cancelled, exit 130): a
       // half-filled bed is no state to resume from, and the filling is redone from the seed. The
