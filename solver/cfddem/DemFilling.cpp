@@ -150,12 +150,18 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
   const double t0 = dem.time();
   const double gap = 1.02 * 2.0 * r;  // parcels start just clear of each other
   if (o.stage_started) o.stage_started(FillStage::Inserting);
-  // Progress of the insertion: the parcels before the current batch, plus the batch's as it falls.
-  long before_batch = 0;
-  auto inserting = [&](double batch_parcels, double fallen) {
-    if (o.progress && count > 0)
-      o.progress(FillStage::Inserting, std::min(1.0, (double(before_batch) + batch_parcels * fallen) / double(count)));
+  // Progress of the insertion in parcel DEM steps, the DEM's work, against the work expected once the
+  // first batch shows how many parcels a batch takes (each later one as many, the last the rest): a
+  // batch falls as long as the first, with every parcel inserted so far. Held below 1 until the last
+  // batch has fallen, in case the region takes fewer parcels as the bed rises into it.
+  constexpr double kBeforeTheEnd = 0.999;
+  double work_done = 0.0, work_expected = 0.0, reported = 0.0;
+  auto inserting = [&](double fall_work) {
+    if (!o.progress || !(work_expected > 0.0)) return;
+    reported = std::max(reported, std::min(kBeforeTheEnd, (work_done + fall_work) / work_expected));
+    o.progress(FillStage::Inserting, reported);
   };
+  if (o.progress) o.progress(FillStage::Inserting, 0.0);
   while (result.inserted < count) {
     if (result.batches >= o.max_batches)
       throw RunError("DEM filling: " + std::to_string(count - result.inserted) + " of " +
@@ -170,14 +176,13 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
           (p.x[i].array() < region.upper.array() + 2 * r).all())
         occ.add(p.x[i]);
     throwIfStopRequested(dem, o.stop_requested);
-    before_batch = result.inserted;
-    inserting(0.0, 0.0);
+    inserting(0.0);
     long misses = 0, batch = 0;
     const long max_misses = 2000 + 20 * (count - result.inserted);
     for (long attempts = 1; result.inserted < count && misses < max_misses; ++attempts) {
       if (attempts % kInsertionAttemptsPerPoll == 0) {
         throwIfStopRequested(dem, o.stop_requested);
-        inserting(0.0, 0.0);
+        inserting(0.0);
       }
       const Vector3d x = lo + (hi - lo).cwiseProduct(Vector3d(u(rng), u(rng), u(rng)));
       if (dem.walls().clearance(x) < 1.01 * r || (o.inside && !o.inside(x)) || !occ.free(x, gap)) {
@@ -193,10 +198,17 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count, c
                   result.inserted, count);
     if (batch == 0 && g == 0.0) throw RunError("DEM filling: no room and no gravity to make room");
     // Let the batch fall clear (after the last one too, so settling starts with the bed in motion).
-    runStoppable(dem, fall_steps, o.stop_requested, [&](long s) { inserting(double(batch), double(s) / double(fall_steps)); });
-    before_batch = result.inserted;
+    if (!(work_expected > 0.0) && batch > 0) {
+      for (long in = 0; in < count;) {
+        in = std::min(count, in + batch);
+        work_expected += double(in) * double(fall_steps);
+      }
+    }
+    const double present = double(dem.particles().size());
+    runStoppable(dem, fall_steps, o.stop_requested, [&](long s) { inserting(double(s) * present); });
+    work_done += double(fall_steps) * present;
   }
-  inserting(0.0, 0.0);  // every parcel in and fallen: 1
+  if (o.progress) o.progress(FillStage::Inserting, 1.0);  // every parcel in and fallen
   result.fill_time = dem.time() - t0;
   if (o.stage_started) o.stage_started(FillStage::Settling);
   std::function<void(double)> settling;

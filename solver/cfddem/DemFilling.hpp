@@ -41,9 +41,10 @@ struct FillOptions {
   std::function<void(FillStage)> stage_started;
   /// Called before every DEM step and with every stop poll of the insertion: the stage and how far it
   /// is, in [0, 1], non-decreasing within a stage and 1 at its end (a large bed fills for hours, and
-  /// its job's progress must move meanwhile). Inserting: parcels inserted over parcels to insert, each
-  /// batch counted in as it falls (the parcels before it plus the batch's times the part of its fall
-  /// done). Settling: fillSettleFraction(). Empty: not called.
+  /// its job's progress must move meanwhile). Inserting: the parcel DEM steps done against those
+  /// expected once the first batch shows how many parcels a batch takes (each later batch as many, the
+  /// last one the rest, each falling as long as the first with every parcel inserted so far), held
+  /// below 1 until the last batch has fallen. Settling: fillSettleFraction(). Empty: not called.
   std::function<void(FillStage, double)> progress;
   /// A new parcel's centre must also lie inside the open region by this test (the apparatus's signed
   /// distance > 0): the walls' clearance is a distance, the same in front of a wall and behind it, and
