@@ -23,7 +23,10 @@ void ProgressView::update(const nlohmann::json& job) {
   const auto number = [&](const char* key) {
     return p.contains(key) && p[key].is_number() ? p[key].get<double>() : NAN;
   };
-  const double simTime = number("sim_time"), eta = number("eta_s");
+  const double simTime = number("sim_time"), eta = number("eta_s"), phaseFraction = number("phase_fraction");
+  // The phase only while the job runs: a finished job's last phase says nothing.
+  const bool running = state == "RUNNING" || state == "CANCELLING";
+  const std::string phase = running && p.contains("phase") && p["phase"].is_string() ? p["phase"].get<std::string>() : "";
   char text[256];
   std::string line;
   if (terminal_) {
@@ -33,11 +36,23 @@ void ProgressView::update(const nlohmann::json& job) {
                   std::string(static_cast<std::size_t>(filled), '#').c_str(),
                   std::string(static_cast<std::size_t>(kWidth - filled), ' ').c_str(), 100 * fraction);
     line = text;
+    if (!phase.empty()) {
+      line += "  " + phase;
+      if (std::isfinite(phaseFraction)) {
+        std::snprintf(text, sizeof text, " %.0f%%", 100 * phaseFraction);
+        line += text;
+      }
+    }
     if (std::isfinite(simTime)) line += "  sim " + formatDuration(simTime);
     if (std::isfinite(eta) && state == "RUNNING") line += "  ETA " + formatDuration(eta);
   } else {
     std::snprintf(text, sizeof text, "%s %.1f%%", state.c_str(), 100 * fraction);
     line = text;
+    if (!phase.empty()) line += " phase=" + phase;
+    if (!phase.empty() && std::isfinite(phaseFraction)) {
+      std::snprintf(text, sizeof text, " phase_fraction=%.2f", phaseFraction);
+      line += text;
+    }
     if (std::isfinite(simTime)) line += " sim_time=" + std::to_string(simTime) + "s";
     if (std::isfinite(eta) && state == "RUNNING") line += " eta=" + formatDuration(eta);
   }

@@ -110,6 +110,12 @@ void printStatus(const json& job) {
   const auto& p = job["progress"];
   std::cout << "progress:  " << fmtNumber(p["fraction"].is_number() ? json(100 * p["fraction"].get<double>()) : json()) << " %"
             << "  sim_time " << fmtNumber(p["sim_time"]) << " s  eta " << fmtNumber(p["eta_s"]) << " s\n";
+  if (p.contains("phase") && p["phase"].is_string()) {
+    std::cout << "phase:     " << p["phase"].get<std::string>();
+    if (p.contains("phase_fraction") && p["phase_fraction"].is_number())
+      std::cout << " " << fmtNumber(json(100 * p["phase_fraction"].get<double>())) << " %";
+    std::cout << "\n";
+  }
   for (const char* key : {"owner", "database", "created_at", "started_at", "finished_at", "error"})
     if (job.contains(key) && job[key].is_string())
       std::cout << key << ":" << std::string(std::max<std::size_t>(1, 10 - std::min<std::size_t>(10, std::string(key).size())), ' ')

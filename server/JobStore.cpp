@@ -34,7 +34,7 @@ namespace {
 
 // Ordered migrations: entry i brings the schema from version i to i + 1. Never edit a released
 // entry; append a new one.
-const std::array<const char*, 3> kMigrations = {
+const std::array<const char*, 4> kMigrations = {
     R"sql(
 CREATE TABLE jobs (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -96,6 +96,11 @@ ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT 'admin';
 UPDATE jobs SET idempotency_key = 'admin/' || idempotency_key WHERE idempotency_key IS NOT NULL;
 CREATE INDEX jobs_by_owner ON jobs(owner, seq);
 ALTER TABLE databases ADD COLUMN owner TEXT NOT NULL DEFAULT 'admin';
+)sql",
+    // The phase a running job is in and how far that phase is (the solver's progress lines).
+    R"sql(
+ALTER TABLE jobs ADD COLUMN phase TEXT;
+ALTER TABLE jobs ADD COLUMN phase_fraction REAL;
 )sql"};
 
 /// The stored form of an Idempotency-Key: OWNER/KEY. Keys are names clients choose ("quick-db-1"), so
@@ -213,7 +218,8 @@ class Transaction {
 
 constexpr const char* kJobColumns =
     "seq, id, kind, state, request, idempotency_key, body_hash, database_ref, progress, sim_time, "
-    "wall_time, eta_s, created_at, started_at, finished_at, updated_at, error, attempt, owner";
+    "wall_time, eta_s, created_at, started_at, finished_at, updated_at, error, attempt, owner, phase, "
+    "phase_fraction";
 
 void insertEvent(sqlite3* db, const std::string& id, const std::string& from, const std::string& to,
                  const std::string& reason, const std::string& at) {
@@ -321,6 +327,8 @@ JobRecord JobStore::readJob(void* statement) {
   j.error = s.text(16);
   j.attempt = static_cast<int>(s.integer(17));
   j.owner = s.text(18);
+  j.phase = s.text(19);
+  j.phaseFraction = s.optDouble(20);
   return j;
 }
 
@@ -391,7 +399,9 @@ bool JobStore::transition(const std::string& id, const std::string& from, const 
               "UPDATE jobs SET state = ?3, updated_at = ?4, "
               "finished_at = CASE WHEN ?3 IN ('SUCCEEDED','FAILED','CANCELLED') THEN ?4 ELSE NULL END, "
               "error = CASE WHEN ?5 IS NULL THEN error ELSE ?5 END, "
-              "eta_s = CASE WHEN ?3 = 'QUEUED' THEN NULL ELSE eta_s END "
+              "eta_s = CASE WHEN ?3 = 'QUEUED' THEN NULL ELSE eta_s END, "
+              "phase = CASE WHEN ?3 IN ('RUNNING','CANCELLING') THEN phase ELSE NULL END, "
+              "phase_fraction = CASE WHEN ?3 IN ('RUNNING','CANCELLING') THEN phase_fraction ELSE NULL END "
               "WHERE id = ?1 AND state = ?2");
   s.bind(1, id).bind(2, from).bind(3, to).bind(4, now).bindOrNull(5, error).run();
   if (sqlite3_changes(db_) == 0) return false;
@@ -424,13 +434,14 @@ bool JobStore::markStarted(const std::string& id) {
 }
 
 void JobStore::updateProgress(const std::string& id, double fraction, std::optional<double> simTime,
-                              std::optional<double> wallTime, std::optional<double> eta) {
+                              std::optional<double> wallTime, std::optional<double> eta, const std::string& phase,
+                              std::optional<double> phaseFraction) {
   std::lock_guard lock(mutex_);
   Statement s(db_,
               "UPDATE jobs SET progress = ?2, sim_time = ?3, wall_time = ?4, eta_s = ?5, "
-              "updated_at = ?6 WHERE id = ?1");
+              "updated_at = ?6, phase = ?7, phase_fraction = ?8 WHERE id = ?1");
   s.bind(1, id).bind(2, fraction).bind(3, simTime).bind(4, wallTime).bind(5, eta);
-  s.bind(6, nowRfc3339()).run();
+  s.bind(6, nowRfc3339()).bindOrNull(7, phase).bind(8, phaseFraction).run();
   changed(id);
 }
 
@@ -445,8 +456,8 @@ bool JobStore::markSucceeded(const std::string& id, const nlohmann::json& summar
   const std::string from = current.text(0);
   if (from != state::running && from != state::cancelling) return false;
   Statement s(db_,
-              "UPDATE jobs SET state = 'SUCCEEDED', progress = 1, eta_s = 0, finished_at = ?2, "
-              "updated_at = ?2 WHERE id = ?1");
+              "UPDATE jobs SET state = 'SUCCEEDED', progress = 1, eta_s = 0, phase = NULL, phase_fraction = NULL, "
+              "finished_at = ?2, updated_at = ?2 WHERE id = ?1");
   s.bind(1, id).bind(2, now).run();
   Statement sum(db_, "INSERT OR REPLACE INTO summaries(job_id, summary) VALUES(?1, ?2)");
   sum.bind(1, id).bind(2, summary.dump()).run();

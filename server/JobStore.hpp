@@ -49,6 +49,8 @@ struct JobRecord {
   std::string error;
   int attempt = 0;               ///< number of times a worker started the job
   std::string owner;             ///< the user who submitted it (Users.hpp)
+  std::string phase;             ///< the phase a running job is in ("fill", "run", ...); empty if none
+  std::optional<double> phaseFraction;  ///< how far that phase is [-]
 };
 
 /// One bin of a job's coverage histogram.
@@ -109,8 +111,10 @@ class JobStore {
   std::vector<JobRecord> queued(int limit);
   /// QUEUED -> RUNNING with attempt + 1 and started_at; false if it was no longer QUEUED.
   bool markStarted(const std::string& id);
+  /// The solver's last progress line (docs/contracts.md, "Progress"); `phase` empty: none named.
   void updateProgress(const std::string& id, double fraction, std::optional<double> simTime,
-                      std::optional<double> wallTime, std::optional<double> eta);
+                      std::optional<double> wallTime, std::optional<double> eta, const std::string& phase = {},
+                      std::optional<double> phaseFraction = std::nullopt);
   /// RUNNING/CANCELLING -> SUCCEEDED, storing the summary and its coverage bins in one transaction.
   bool markSucceeded(const std::string& id, const nlohmann::json& summary,
                      const std::vector<CoverageBin>& bins);

@@ -35,6 +35,22 @@ std::optional<double> optionalNumber(const nlohmann::json& j, const char* key) {
   return it->get<double>();
 }
 
+/// The phase a progress line names: a short word ("fill", "run"), empty when absent or not one.
+std::string phaseOf(const nlohmann::json& j) {
+  constexpr std::size_t kPhaseMaxChars = 32;
+  auto it = j.find("phase");
+  if (it == j.end() || !it->is_string()) return {};
+  const std::string& phase = it->get_ref<const std::string&>();
+  return phase.size() <= kPhaseMaxChars ? phase : std::string();
+}
+
+/// Stores the progress line `p` as the job's progress.
+void storeProgress(JobStore& store, const std::string& id, const nlohmann::json& p) {
+  const auto number = [&](const char* key) { return optionalNumber(p, key); };
+  store.updateProgress(id, number("fraction").value_or(0.0), number("sim_time"), number("wall_time"),
+                       number("eta_s"), phaseOf(p), number("phase_fraction"));
+}
+
 /// The last non-empty lines the solver wrote to stderr during this attempt.
 std::string logTail(const std::filesystem::path& log, std::streamoff from) {
   std::ifstream in(log, std::ios::binary);
@@ -290,17 +306,14 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       }
       const auto now = std::chrono::steady_clock::now();
       if (!latest.is_null() && now - lastWrite >= kProgressWriteInterval) {
-        store_.updateProgress(job.id, latest.value("fraction", 0.0),
-                              optionalNumber(latest, "sim_time"),
-                              optionalNumber(latest, "wall_time"), optionalNumber(latest, "eta_s"));
+        storeProgress(store_, job.id, latest);
         lastWrite = now;
         latest = nullptr;
       }
     }
     ::close(pipeFds[0]);
     if (!latest.is_null())
-      store_.updateProgress(job.id, latest.value("fraction", 0.0), optionalNumber(latest, "sim_time"),
-                            optionalNumber(latest, "wall_time"), optionalNumber(latest, "eta_s"));
+      storeProgress(store_, job.id, latest);
     while (::waitpid(pid, &waitStatus, 0) < 0 && errno == EINTR) {
     }
     std::lock_guard lock(mutex_);

@@ -58,11 +58,13 @@ CfdDemSimulation::CfdDemSimulation(const Scene& scene, std::uint64_t seed, const
 CfdDemSimulation::~CfdDemSimulation() = default;
 
 FillResult CfdDemSimulation::fillAndSettle(const std::function<bool()>& stopRequested,
-                                           const std::function<void(FillStage)>& stageStarted) {
+                                           const std::function<void(FillStage)>& stageStarted,
+                                           const std::function<void(FillStage, double)>& progress) {
   FillOptions options;
   options.seed = seed_;
   options.stop_requested = stopRequested;
   options.stage_started = stageStarted;
+  options.progress = progress;
   options.max_settle_time = scene_.dem.settle_time;
   options.inside = [this](const Eigen::Vector3d& x) { return apparatus_->signedDistance(x) > 0.0; };
   const FillResult r = rcfd::fillAndSettle(*dem_, defaultFillRegion(scene_.apparatus), parcelsForBedMass(scene_), options);
@@ -70,6 +72,8 @@ FillResult CfdDemSimulation::fillAndSettle(const std::function<bool()>& stopRequ
   lastInterval_ = 0.0;  // the gas starts from here: no rate of change of alpha_G yet
   return r;
 }
+
+long CfdDemSimulation::fillFallSteps() const { return fallStepsPerBatch(*dem_, defaultFillRegion(scene_.apparatus)); }
 
 void CfdDemSimulation::setFlowFactor(double factor) {
   if (!(factor >= 0.0 && factor <= 1.0))

@@ -57,10 +57,13 @@ class CfdDemSimulation {
   ~CfdDemSimulation();
 
   /// Inserts the scene's bed mass as parcels and lets it settle (DEM only, gas off), at most
-  /// scene.dem.settle_time. Deterministic for the seed. `stopRequested` and `stageStarted` as
-  /// FillOptions::stop_requested and FillOptions::stage_started.
+  /// scene.dem.settle_time. Deterministic for the seed. `stopRequested`, `stageStarted` and `progress`
+  /// as FillOptions::stop_requested, FillOptions::stage_started and FillOptions::progress.
   FillResult fillAndSettle(const std::function<bool()>& stopRequested = {},
-                           const std::function<void(FillStage)>& stageStarted = {});
+                           const std::function<void(FillStage)>& stageStarted = {},
+                           const std::function<void(FillStage, double)>& progress = {});
+  /// DEM steps each batch of fillAndSettle() falls (fallStepsPerBatch() of the scene's fill region).
+  long fillFallSteps() const;
 
   /// Scales the inlet and nozzle flows by factor in [0, 1] (the database job ramps the gas up).
   void setFlowFactor(double factor);

@@ -39,6 +39,13 @@ struct FillOptions {
   std::function<bool()> stop_requested;
   /// Called as the filling enters each stage (the job's progress names it). Empty: not called.
   std::function<void(FillStage)> stage_started;
+  /// Called before every DEM step and with every stop poll of the insertion: the stage and how far it
+  /// is, in [0, 1], non-decreasing within a stage and 1 at its end (a large bed fills for hours, and
+  /// its job's progress must move meanwhile). Inserting: the parcel DEM steps done against those
+  /// expected once the first batch shows how many parcels a batch takes (each later batch as many, the
+  /// last one the rest, each falling as long as the first with every parcel inserted so far), held
+  /// below 1 until the last batch has fallen. Settling: fillSettleFraction(). Empty: not called.
+  std::function<void(FillStage, double)> progress;
   /// A new parcel's centre must also lie inside the open region by this test (the apparatus's signed
   /// distance > 0): the walls' clearance is a distance, the same in front of a wall and behind it, and
   /// a region that reaches behind a steep V-bottom would otherwise take parcels there. Empty: any.
@@ -53,6 +60,17 @@ struct FillResult {
   double kinetic_energy = 0.0;  ///< at the end [J]
   bool settled = false;       ///< the energy criterion was met (else max_settle_time ran out)
 };
+
+/// How far settling is, in [0, 1], from what decides its end: the larger of the time run against
+/// `maxTime` and the kinetic energy's way down to the criterion on a log scale,
+/// ln(E0 / E) / ln(E0 / E_settled), E0 the energy at the first check. Settling ends at the first of the
+/// two, and the energy falls about exponentially, so each moves about linearly towards its end. Not
+/// monotone by itself (the energy of a settling bed rises now and then): callers keep the maximum.
+double fillSettleFraction(double time, double maxTime, double energy, double firstEnergy, double settledEnergy);
+
+/// DEM steps a batch is given to fall clear of `region` before the next (sqrt(2 h / g), h the
+/// region's height plus a parcel diameter).
+long fallStepsPerBatch(const DemSystem& dem, const FillRegion& region);
 
 /// Number of parcels of the scene's bed: M_P / (cg^3 m_P), rounded to the nearest integer.
 long parcelsForBedMass(const Scene& scene);
@@ -69,8 +87,10 @@ FillResult fillAndSettle(DemSystem& dem, const FillRegion& region, long count,
                          const FillOptions& options = {});
 
 /// Runs until the kinetic energy criterion holds (checked every millisecond of simulated time) or
-/// max_time passes; returns the time run [s]. `stop_requested` as in FillOptions.
+/// max_time passes; returns the time run [s]. `stop_requested` as in FillOptions; `progress`, if
+/// given, before every DEM step with the running maximum of fillSettleFraction() and with 1 at the end.
 double settle(DemSystem& dem, double max_time, double settled_energy_fraction, bool* settled = nullptr,
-              const std::function<bool()>& stop_requested = {});
+              const std::function<bool()>& stop_requested = {},
+              const std::function<void(double)>& progress = {});
 
 }  // namespace rcfd

@@ -23,6 +23,7 @@ const bool registered = rcfd::cli::addCommand(
         int threads = 0;
         long stopAfter = -1;
         int maxPressureIterations = 0;
+        double progressInterval = 1.0;
         double cancelDeadline = kDefaultCancelDeadlineSeconds;
       };
       auto args = std::make_shared<Args>();
@@ -39,6 +40,10 @@ const bool registered = rcfd::cli::addCommand(
       app.add_option("--stop-after-steps", args->stopAfter,
                      "testing: checkpoint and exit 130 after this many steps")
           ->group("");
+      app.add_option("--progress-interval", args->progressInterval,
+                     "testing: seconds of wall time between progress reports (0: every report)")
+          ->group("")
+          ->check(CLI::NonNegativeNumber);
       app.add_option("--max-pressure-iterations", args->maxPressureIterations,
                      "testing: cap the gas pressure solver's iterations per step (a solve that does not converge)")
           ->group("");
@@ -50,6 +55,7 @@ const bool registered = rcfd::cli::addCommand(
         rcfd::RunOptions options;
         options.outDir = args->out;
         options.progressJson = args->progressJson;
+        options.progressInterval = args->progressInterval;
         options.stopAfterSteps = args->stopAfter;
         options.maxPressureIterations = args->maxPressureIterations;
         const auto summary = rcfd::runJob(job, options);

@@ -67,6 +67,9 @@ struct FrameStorage {
   /// Polled before each frame read into RAM (cacheBytes == 0: a long database takes minutes); true
   /// ends the open with rcfd::Cancelled. Empty: never.
   std::function<bool()> stopRequested = {};
+  /// Called after each frame read into RAM (cacheBytes == 0) with the fraction of the frames read.
+  /// Empty: never.
+  std::function<void(double)> progress = {};
 };
 
 struct FrameCacheStats {

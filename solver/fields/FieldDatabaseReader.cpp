@@ -327,6 +327,7 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
         throw Cancelled("stopped while reading " + path + " into memory (frame " + std::to_string(i) + " of " +
                         std::to_string(h.frames) + ")");
       frames[std::size_t(i)] = reader->read(i);
+      if (storage.progress) storage.progress(double(i + 1) / double(h.frames));
     }
     return std::make_shared<InRamDatabase>(std::move(h), std::move(frames));  // closes the file
   }

@@ -96,35 +96,67 @@ class CalibrationJob final : public JobRunner {
     const std::string runsDir = options.outDir + "/runs";
     double priorWall = 0.0;
     if (fs::exists(runsDir + "/prior_wall_time_s")) std::ifstream(runsDir + "/prior_wall_time_s") >> priorWall;
+    // The settings a run of D0 value i is kept for (DIR/runs/d0_<i>/key.json).
+    auto keyOf = [&](std::size_t i) -> nlohmann::json {
+      return {{"d0", d0[i]},          {"seed", job.seed},       {"steps", steps},
+              {"discard_steps", discardSteps}, {"tracers", scene.rcfd.tracers},
+              {"dt", scene.rcfd.dt},  {"database", job.database},
+              {"effects", calibrationEffects(scene)}};
+    };
+    // Steps done by earlier processes, counted before anything runs, so that this process's progress
+    // and ETA start from them (a resumed run's steps are counted here, not when it is reached).
+    std::vector<char> counted(d0.size(), 0);
+    std::int64_t priorSteps = 0;
+    for (std::size_t i = 0; i < d0.size(); ++i) {
+      const std::string dir = runsDir + "/d0_" + std::to_string(i);
+      if (!fs::exists(dir + "/key.json") || readJsonFile(dir + "/key.json") != keyOf(i)) continue;
+      if (fs::exists(dir + "/summary.json")) {
+        priorSteps += steps;
+      } else if (fs::exists(dir + "/checkpoint.h5")) {
+        h5::File f(dir + "/checkpoint.h5", h5::File::Mode::ReadOnly);
+        if (!f.exists("/state/step")) continue;
+        priorSteps += f.readInt64s("/state/step").at(0);
+      }
+      counted[i] = 1;
+    }
+    const double tracers = double(scene.rcfd.tracers);
+    double totalSteps = double(steps) * double(d0.size());
+    // The recurrence set-up and the runs' tracer steps weighted by their expected cost.
+    TracerJobWork work(recurrenceWork(scene, job.database), totalSteps * tracers);
+    std::atomic<std::int64_t> stepsThisProcess{0}, stepsDone{priorSteps};
+    auto fraction = [&](double recurrenceDone) { return work.fraction(recurrenceDone, double(stepsDone) * tracers); };
+
     ProgressReporter progress(options.progressJson, options.progressInterval, "calibration ");
     progress.setPriorWallTime(priorWall);
+    progress.setStartFraction(fraction(0.0));
     progress.setPhase("recurrence");
-    progress.report(0.0, 0.0, true);
+    progress.setPhaseFraction(0.0);
+    progress.report(fraction(0.0), 0.0, true);
 
     // One path for every D0 (the paper used a precomputed path to remove path randomness).
-    const RecurrenceSetup rec =
-        prepareRecurrence(scene, job.database, steps + 2, job.seed, [] { return cancellationRequested(); });
+    const RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed,
+                                                  [] { return cancellationRequested(); },
+                                                  [&](double f) {
+                                                    progress.setPhaseFraction(f);
+                                                    progress.report(fraction(f), 0.0);
+                                                  });
     fs::create_directories(runsDir);
 
     // --- the D0 runs ---
-    std::atomic<std::int64_t> stepsThisProcess{0}, stepsDone{0};
     std::atomic<bool> stop{false};
     std::mutex mutex;  // progress reporter and the first error
     std::exception_ptr error;
-    double totalSteps = double(steps) * double(d0.size());
 
     auto runOne = [&](std::size_t i) -> RunOutcome {
       const std::string dir = runsDir + "/d0_" + std::to_string(i);
-      const nlohmann::json key = {{"d0", d0[i]},          {"seed", job.seed},       {"steps", steps},
-                                  {"discard_steps", discardSteps}, {"tracers", scene.rcfd.tracers},
-                                  {"dt", scene.rcfd.dt},  {"database", job.database},
-                                  {"effects", calibrationEffects(scene)}};
+      const nlohmann::json key = keyOf(i);
+      const bool alreadyCounted = i < counted.size() && counted[i];
       if (fs::exists(dir + "/key.json") && readJsonFile(dir + "/key.json") != key) {
         spdlog::warn("{} holds a run of other settings; starting D0 = {} afresh", dir, d0[i]);
         fs::remove_all(dir);
       }
       if (fs::exists(dir + "/summary.json")) {
-        stepsDone += steps;
+        if (!alreadyCounted) stepsDone += steps;
         return RunOutcome::Finished;  // finished by an earlier process
       }
       if (cancellationRequested()) {  // not worth setting up a run only to checkpoint its first step
@@ -143,7 +175,7 @@ class CalibrationJob final : public JobRunner {
         sim.loadCheckpoint(checkpoint);
         spdlog::info("D0 = {}: resumed at step {} of {}", d0[i], sim.currentStep(), steps);
       }
-      stepsDone += sim.currentStep();
+      if (!alreadyCounted) stepsDone += sim.currentStep();
       const std::int64_t checkpointEvery =
           std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / scene.rcfd.dt));
       while (sim.currentStep() < steps) {
@@ -162,7 +194,8 @@ class CalibrationJob final : public JobRunner {
           sim.saveCheckpoint(checkpoint);
         }
         if (mutex.try_lock()) {
-          progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt);  // summed over D0
+          progress.setPhaseFraction(double(stepsDone) / totalSteps);
+          progress.report(fraction(1.0), double(stepsDone) * scene.rcfd.dt);  // summed over D0
           mutex.unlock();
         }
       }
@@ -229,11 +262,12 @@ class CalibrationJob final : public JobRunner {
     nlohmann::json extension = {{"added", nlohmann::json::array()}, {"binding_d0", bindingD0}};
     for (std::size_t first = 0;;) {
       progress.setPhase("runs");
-      progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt, true);
+      progress.setPhaseFraction(double(stepsDone) / totalSteps);
+      progress.report(fraction(1.0), double(stepsDone) * scene.rcfd.dt, true);
       runRange(first, d0.size());
       first = d0.size();
       progress.setPhase("report");
-      progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt, true);
+      progress.report(fraction(1.0), double(stepsDone) * scene.rcfd.dt, true);
       analysis::CalibrationInputs inputs{scene, *rec.database, d0, runsDir, reference, selection, steps, discardSteps};
       summary = analysis::writeCalibrationReport(inputs, options.outDir + "/result.h5",
                                                  scene.outputs.svg ? options.outDir : std::string());
@@ -254,6 +288,7 @@ class CalibrationJob final : public JobRunner {
       d0.push_back(next);
       extension["added"].push_back(next);
       totalSteps = double(steps) * double(d0.size());
+      work.setTracerSteps(totalSteps * tracers);
     }
     summary["sweep_extension"] = extension;
     progress.report(1.0, totalSteps * scene.rcfd.dt, true);

@@ -34,6 +34,7 @@
 #include "core/Hdf5.hpp"
 #include "fields/FieldDatabase.hpp"
 #include "jobs/Cancellation.hpp"
+#include "jobs/DatabaseProgress.hpp"
 #include "jobs/JobRunner.hpp"
 #include "jobs/Progress.hpp"
 #include "spray/ReferenceCoverage.hpp"
@@ -86,14 +87,6 @@ FieldFrame sampleFrame(const CfdDemSimulation& sim, bool withSpread) {
   f.u_p_down = interleaved(spread.down);
   f.u_p_variance = interleaved(spread.variance);
   return f;
-}
-
-/// The phase of the coupled run `offset` DEM steps after settling (the progress's "phase").
-const char* coupledPhase(const DatabaseSchedule& plan, std::int64_t offset) {
-  if (offset < plan.rampSteps) return "ramp";
-  if (offset < plan.frameOffset(0)) return "warmup";
-  if (offset < plan.frameOffset(plan.frames)) return "sample";
-  return "reference";
 }
 
 /// The job's own counters, saved beside the simulation state.
@@ -153,24 +146,15 @@ class DatabaseJob final : public JobRunner {
     }
 
     const double chamberTop = sim.apparatus().upperCorner().y();
-    const double total = scene.dem.settle_time + double(plan.endOffset()) * plan.dtDem;
-    auto fraction = [&] {
-      if (!st.settled) return 0.0;
-      const double done = scene.dem.settle_time + double(sim.demStep() - st.settledStep) * plan.dtDem;
-      return total > 0.0 ? std::min(1.0, done / total) : 1.0;
-    };
+    // The phases weighted by their expected cost (jobs/DatabaseProgress.hpp): the fraction grows about
+    // linearly in wall time from the filling on, so the ETA of its first minute holds for the rest.
+    const DatabaseProgress weights(plan, scene.dem.settle_time, parcelsForBedMass(scene), sim.fillFallSteps(),
+                                   sim.grid().cellCount(), sim.hasGas());
+    auto fraction = [&] { return st.settled ? weights.coupled(sim.demStep() - st.settledStep) : 0.0; };
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count(); };
-    // The ETA is this process's rate over the phase it is in: a fresh reporter after the filling, whose
-    // length does not tell how fast the coupled run goes.
-    std::unique_ptr<ProgressReporter> progress;
-    auto startProgress = [&] {
-      const std::string phase = progress ? progress->phase() : std::string();
-      progress = std::make_unique<ProgressReporter>(options.progressJson, options.progressInterval);
-      progress->setPriorWallTime(st.wallTime + elapsed());
-      progress->setStartFraction(fraction());
-      progress->setPhase(phase);
-    };
-    startProgress();
+    ProgressReporter progress(options.progressJson, options.progressInterval);
+    progress.setPriorWallTime(st.wallTime + elapsed());
+    progress.setStartFraction(fraction());
     auto save = [&] {
       JobState now = st;
       now.wallTime = st.wallTime + elapsed();
@@ -183,20 +167,21 @@ class DatabaseJob final : public JobRunner {
     };
 
     if (!st.settled) {
-      progress->setPhase("fill");
-      progress->report(0.0, sim.time(), true);
+      progress.setPhase("fill");
+      progress.setPhaseFraction(0.0);
+      progress.report(0.0, sim.time(), true);
       // A stop request during the filling ends the job without a checkpoint (Cancelled, exit 130): a
-      // half-filled bed is no state to resume from, and the filling is redone from the seed. The poll
-      // before every DEM step also keeps the progress going (a large bed fills for hours).
-      st.fill = sim.fillAndSettle(
-          [&] {
-            progress->report(0.0, sim.dem().time());
-            return cancellationRequested();
-          },
-          [&](FillStage stage) {
-            progress->setPhase(stage == FillStage::Inserting ? "fill" : "settle");
-            progress->report(0.0, sim.dem().time());
-          });
+      // half-filled bed is no state to resume from, and the filling is redone from the seed. The
+      // progress comes before every DEM step (a large bed fills for hours).
+      auto phaseOf = [](FillStage stage) { return stage == FillStage::Inserting ? "fill" : "settle"; };
+      st.fill = sim.fillAndSettle([] { return cancellationRequested(); },
+                                  [&](FillStage stage) { progress.setPhase(phaseOf(stage)); },
+                                  [&](FillStage stage, double f) {
+                                    progress.setPhase(phaseOf(stage));
+                                    progress.setPhaseFraction(f);
+                                    progress.report(stage == FillStage::Inserting ? weights.fill(f) : weights.settle(f),
+                                                     sim.dem().time());
+                                  });
       st.settled = true;
       st.settledStep = sim.demStep();
       makeRecorder();
@@ -207,8 +192,8 @@ class DatabaseJob final : public JobRunner {
         writer = std::make_unique<FieldDatabaseWriter>(databasePath, sim.grid(), fluid, plan.dtRec(),
                                                        scene.source_json, writeOptions);
       }
-      progress->report(fraction(), sim.time(), true);
-      startProgress();
+      progress.setPhaseFraction(1.0);
+      progress.report(fraction(), sim.time(), true);
       if (cancellationRequested() || options.stopAfterSteps == 0) cancelled("after settling");
       // The filling is the longest stretch without one (an hour on the ProCell bed): keep it at once.
       save();
@@ -224,7 +209,7 @@ class DatabaseJob final : public JobRunner {
     while (true) {
       // Events at the current instant first: a checkpoint taken after a step resumes here.
       const std::int64_t offset = sim.demStep() - st.settledStep;
-      progress->setPhase(coupledPhase(plan, offset));
+      progress.setPhase(coupledPhase(plan, offset));
       if (st.framesWritten < plan.frames && offset == plan.frameOffset(st.framesWritten)) {
         const FieldFrame frame = sampleFrame(sim, writer->writesVelocitySpread());
         const ForcedExitDeferral keepTheDatabaseReadable;
@@ -264,16 +249,19 @@ class DatabaseJob final : public JobRunner {
       const bool stopForTest =
           options.stopAfterSteps >= 0 && st.couplingSteps - firstCouplingStep >= options.stopAfterSteps;
       if (cancellationRequested() || stopForTest) {
-        cancelled("in the " + progress->phase() + " phase at coupling step " + std::to_string(st.couplingSteps));
+        cancelled("in the " + progress.phase() + " phase at coupling step " + std::to_string(st.couplingSteps));
       }
       if (sim.demStep() - lastCheckpoint >= checkpointEvery) {
         save();
         lastCheckpoint = sim.demStep();
       }
-      progress->report(fraction(), sim.time());
+      const std::int64_t reached = sim.demStep() - st.settledStep;
+      progress.setPhase(coupledPhase(plan, reached));
+      progress.setPhaseFraction(coupledPhaseFraction(plan, reached));
+      progress.report(fraction(), sim.time());
     }
-    progress->setPhase("results");
-    progress->report(1.0, sim.time(), true);
+    progress.setPhase("results");
+    progress.report(1.0, sim.time(), true);
     {
       const ForcedExitDeferral keepTheDatabaseReadable;
       writer->close();

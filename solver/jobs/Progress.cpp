@@ -1,5 +1,7 @@
 #include "jobs/Progress.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -8,15 +10,6 @@ namespace rcfd {
 ProgressReporter::ProgressReporter(bool json, double intervalSeconds, std::string label)
     : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
 
-double EtaEstimate::update(double t, double fraction) {
-  samples_.emplace_back(t, fraction);
-  // Keep the newest sample at or before the window's start, so the rate spans the whole window.
-  while (samples_.size() > 2 && samples_[1].first <= t - window_) samples_.pop_front();
-  const auto& [t0, f0] = samples_.front();
-  const double rate = t > t0 ? (fraction - f0) / (t - t0) : 0.0;
-  return rate > 0.0 ? (1.0 - fraction) / rate : -1.0;
-}
-
 double ProgressReporter::wallTime() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
@@ -24,7 +17,18 @@ double ProgressReporter::wallTime() const {
 void ProgressReporter::setPhase(std::string phase) {
   if (phase == phase_) return;
   phase_ = std::move(phase);
+  phaseFraction_ = -1.0;
   phaseReported_ = false;
+}
+
+std::string humanDuration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0.0) return "?";
+  const long s = std::lround(seconds);
+  char out[48];
+  if (s >= 3600) std::snprintf(out, sizeof out, "%ld h %02ld min", s / 3600, (s % 3600) / 60);
+  else if (s >= 60) std::snprintf(out, sizeof out, "%ld min %02ld s", s / 60, s % 60);
+  else std::snprintf(out, sizeof out, "%ld s", s);
+  return out;
 }
 
 void ProgressReporter::report(double fraction, double simTime, bool force) {
@@ -32,22 +36,34 @@ void ProgressReporter::report(double fraction, double simTime, bool force) {
   if (!force && phaseReported_ && now - lastReport_ < interval_) return;
   lastReport_ = now;
   phaseReported_ = true;
+  fraction = std::clamp(fraction, 0.0, 1.0);
   const double eta = eta_.update(now, fraction);
   const double wall = prior_ + now;
+  const bool phaseKnown = !phase_.empty() && phaseFraction_ >= 0.0;
+  const double phaseFraction = std::min(1.0, phaseFraction_);
   if (json_) {
     nlohmann::json line = {{"fraction", fraction}, {"sim_time", simTime}, {"wall_time", wall},
                            {"eta_s", eta >= 0.0 ? nlohmann::json(eta) : nlohmann::json(nullptr)}};
     if (!phase_.empty()) line["phase"] = phase_;
+    if (phaseKnown) line["phase_fraction"] = phaseFraction;
     std::printf("%s\n", line.dump().c_str());
     std::fflush(stdout);
   }
-  const std::string label = label_ + (phase_.empty() ? "" : phase_ + " ");
-  if (eta >= 0.0) {
-    std::fprintf(stderr, "%s%5.1f%%  t = %.3f s  wall %.1f s  eta %.0f s\n", label.c_str(), 100.0 * fraction,
-                 simTime, wall, eta);
-  } else {
-    std::fprintf(stderr, "%s%5.1f%%  t = %.3f s  wall %.1f s\n", label.c_str(), 100.0 * fraction, simTime, wall);
+  std::string text = label_;
+  char buffer[160];
+  if (!phase_.empty()) {
+    text += phase_;
+    if (phaseKnown) {
+      std::snprintf(buffer, sizeof buffer, " %3.0f%%", 100.0 * phaseFraction);
+      text += buffer;
+    }
+    text += ", ";
   }
+  std::snprintf(buffer, sizeof buffer, "%5.1f%% in all  t = %.3f s  wall %s", 100.0 * fraction, simTime,
+                humanDuration(wall).c_str());
+  text += buffer;
+  if (eta >= 0.0) text += "  eta " + humanDuration(eta);
+  std::fprintf(stderr, "%s\n", text.c_str());
 }
 
 }  // namespace rcfd

@@ -146,18 +146,29 @@ class TracerJob final : public JobRunner {
 
     const std::string checkpoint = options.outDir + "/checkpoint.h5";
     double priorWall = 0.0;
+    std::int64_t resumedStep = 0;
     if (std::filesystem::exists(checkpoint)) {
       h5::File f(checkpoint, h5::File::Mode::ReadOnly);
       if (f.exists("/state/wall_time")) priorWall = f.readDoubles("/state/wall_time").at(0);
+      if (f.exists("/state/step")) resumedStep = f.readInt64s("/state/step").at(0);
     }
+    // The recurrence set-up and the tracer steps weighted by their expected cost (RecurrenceWork).
+    const TracerJobWork work(recurrenceWork(scene, job.database), double(steps) * double(scene.rcfd.tracers));
+    const double tracers = double(scene.rcfd.tracers);
     ProgressReporter progress(options.progressJson, options.progressInterval);
     progress.setPriorWallTime(priorWall);
+    progress.setStartFraction(work.fraction(0.0, double(resumedStep) * tracers));
     progress.setPhase("recurrence");
-    progress.report(0.0, 0.0, true);
+    progress.setPhaseFraction(0.0);
+    progress.report(work.fraction(0.0, double(resumedStep) * tracers), 0.0, true);
 
     // The path is indexed per frame; dt may divide dt_rec, so size it for the number of frames used.
-    RecurrenceSetup rec =
-        prepareRecurrence(scene, job.database, steps + 2, job.seed, [] { return cancellationRequested(); });
+    RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed,
+                                            [] { return cancellationRequested(); },
+                                            [&](double f) {
+                                              progress.setPhaseFraction(f);
+                                              progress.report(work.fraction(f, double(resumedStep) * tracers), 0.0);
+                                            });
     TracerRunSettings settings{job.seed, steps, 0};
     TracerSimulation sim(scene, rec.database, rec.path, settings);
     if (std::filesystem::exists(checkpoint)) {
@@ -167,9 +178,10 @@ class TracerJob final : public JobRunner {
     const std::int64_t checkpointEvery =
         std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / scene.rcfd.dt));
 
-    progress.setStartFraction(double(sim.currentStep()) / double(steps));
+    auto fraction = [&] { return work.fraction(1.0, double(sim.currentStep()) * tracers); };
     progress.setPhase("run");
-    progress.report(double(sim.currentStep()) / double(steps), sim.time(), true);
+    progress.setPhaseFraction(double(sim.currentStep()) / double(steps));
+    progress.report(fraction(), sim.time(), true);
     auto save = [&] {
       // The wall time goes into the checkpoint in place: a forced exit must not cut either write.
       const ForcedExitDeferral keepTheCheckpoint;
@@ -190,7 +202,8 @@ class TracerJob final : public JobRunner {
       const bool stopForTest = options.stopAfterSteps >= 0 && s - firstStep >= options.stopAfterSteps;
       if (cancellationRequested() || stopForTest) cancelled("in the run phase");
       if (s % checkpointEvery == 0 && s < steps) save();
-      progress.report(double(s) / double(steps), sim.time());
+      progress.setPhaseFraction(double(s) / double(steps));
+      progress.report(fraction(), sim.time());
     }
     progress.setPhase("results");
     progress.report(1.0, sim.time(), true);
@@ -243,15 +256,6 @@ class TracerJob final : public JobRunner {
 
     double priorWall = 0.0;
     if (fs::exists(membersDir + "/prior_wall_time_s")) std::ifstream(membersDir + "/prior_wall_time_s") >> priorWall;
-    ProgressReporter progress(options.progressJson, options.progressInterval);
-    progress.setPriorWallTime(priorWall);
-    progress.setPhase("recurrence");
-    progress.report(0.0, 0.0, true);
-    // One matrix and database for all; member 0's path is the job seed's, the others draw their own.
-    RecurrenceSetup rec =
-        prepareRecurrence(scene, job.database, steps + 2, job.seed, [] { return cancellationRequested(); });
-    fs::create_directories(membersDir);
-
     // Steps already done: finished members and checkpoints of a resumed job.
     const double totalSteps = double(steps) * double(members);
     std::atomic<std::int64_t> stepsDone{0}, stepsThisProcess{0};
@@ -264,6 +268,23 @@ class TracerJob final : public JobRunner {
         stepsDone += f.readInt64s("/state/step").at(0);
       }
     }
+    // The recurrence set-up and the members' tracer steps weighted by their expected cost.
+    const double tracers = double(scene.rcfd.tracers);
+    const TracerJobWork work(recurrenceWork(scene, job.database), totalSteps * tracers);
+    ProgressReporter progress(options.progressJson, options.progressInterval);
+    progress.setPriorWallTime(priorWall);
+    progress.setStartFraction(work.fraction(0.0, double(stepsDone) * tracers));
+    progress.setPhase("recurrence");
+    progress.setPhaseFraction(0.0);
+    progress.report(work.fraction(0.0, double(stepsDone) * tracers), 0.0, true);
+    // One matrix and database for all; member 0's path is the job seed's, the others draw their own.
+    RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed,
+                                            [] { return cancellationRequested(); },
+                                            [&](double f) {
+                                              progress.setPhaseFraction(f);
+                                              progress.report(work.fraction(f, double(stepsDone) * tracers), 0.0);
+                                            });
+    fs::create_directories(membersDir);
     const std::int64_t checkpointEvery =
         std::max<std::int64_t>(1, std::llround(job.checkpoint_interval / scene.rcfd.dt));
     const int budget = std::max(1, threadBudget());
@@ -273,9 +294,9 @@ class TracerJob final : public JobRunner {
     std::mutex mutex;  // the progress reporter and the first error
     std::exception_ptr error;
     spdlog::info("ensemble: {} members x {} steps; {} at a time on {} thread(s)", members, steps, workers, budget);
-    progress.setStartFraction(double(stepsDone) / totalSteps);
     progress.setPhase("run");
-    progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt, true);
+    progress.setPhaseFraction(double(stepsDone) / totalSteps);
+    progress.report(work.fraction(1.0, double(stepsDone) * tracers), double(stepsDone) * scene.rcfd.dt, true);
 
     auto runMember = [&](int k) {
       if (finished(k)) return;
@@ -309,7 +330,8 @@ class TracerJob final : public JobRunner {
         if (options.stopAfterSteps >= 0 && done >= options.stopAfterSteps) stop = true;
         if (sim.currentStep() % checkpointEvery == 0 && sim.currentStep() < steps) save();
         if (mutex.try_lock()) {
-          progress.report(double(stepsDone) / totalSteps, double(stepsDone) * scene.rcfd.dt);
+          progress.setPhaseFraction(double(stepsDone) / totalSteps);
+          progress.report(work.fraction(1.0, double(stepsDone) * tracers), double(stepsDone) * scene.rcfd.dt);
           mutex.unlock();
         }
       }

@@ -62,10 +62,12 @@ namespace {
 
 /// A stop request seen from inside parallel loops: the first true answer is kept, every later poll
 /// skips its work at once, and the caller throws after the loop (exceptions must not leave an OpenMP
-/// region).
+/// region). Also counts the work done, in units of one frame loaded, for the progress.
 class StopPoll {
  public:
-  explicit StopPoll(const std::function<bool()>& request) : request_(request) {}
+  explicit StopPoll(const std::function<bool()>& request, const std::function<void(double)>& progress = kNone,
+                    double totalWork = 0.0)
+      : request_(request), progress_(progress), total_(totalWork) {}
   bool operator()() const {
     if (stopped_.load(std::memory_order_relaxed)) return true;
     if (!request_ || !request_()) return false;
@@ -75,11 +77,26 @@ class StopPoll {
   void throwIfStopped() const {
     if (stopped_.load()) throw Cancelled("stopped while computing the recurrence matrix; nothing of it is kept");
   }
+  /// `units` of work done (from any thread).
+  void advance(double units) const {
+    if (!progress_ || !(total_ > 0.0)) return;
+    const double done = done_.fetch_add(units, std::memory_order_relaxed) + units;
+    progress_(std::min(1.0, done / total_));
+  }
 
  private:
+  static inline const std::function<void(double)> kNone{};
   const std::function<bool()>& request_;
+  const std::function<void(double)>& progress_;
+  double total_;
   mutable std::atomic<bool> stopped_{false};
+  mutable std::atomic<double> done_{0.0};
 };
+
+/// Work of one entry of a tile product against one frame loaded: a frame load copies and transforms
+/// every cell's value, an entry is a dot product over the cells inside a GEMM or a vectorised loop,
+/// about ten times faster per value.
+constexpr double kEntryWork = 0.1;
 
 struct Tile {
   int first, count;
@@ -108,6 +125,7 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store, const 
       try {
         s.fetch(first + f, buffer.data());
         store(f, buffer);
+        stop.advance(1.0);
       } catch (...) {
 #pragma omp critical(rcfd_recurrence_failure)
         if (!failure) failure = std::current_exception();
@@ -183,6 +201,7 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
             target += partial.cast<double>();
           }
         }
+        stop.advance(kEntryWork * a.count * b.count);
       }
       stop.throwIfStopped();
     }
@@ -273,6 +292,7 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
             const int gi = blocks[p].first + a.first + i, gj = blocks[q].first + b.first + j;
             if (gj > gi) D(gi, gj) = D(gj, gi) = acc(i, j);
           }
+        stop.advance(kEntryWork * a.count * b.count);
       }
       stop.throwIfStopped();
     }
@@ -285,7 +305,8 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames, int* blocks,
                                std::int64_t* clamped, GramPrecision precision,
-                               const std::function<bool()>& stopRequested) {
+                               const std::function<bool()>& stopRequested,
+                               const std::function<void(double)>& progress) {
   const int n = series.frames;
   if (n < 1 || series.weights.empty()) {
     throw InputError("recurrence", "/frames", "no frames or no open cells to compare");
@@ -301,7 +322,21 @@ Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
   const int framesPerBlock = int(std::min<std::int64_t>(n, perBlock));
   if (blocks) *blocks = (n + framesPerBlock - 1) / framesPerBlock;
   if (clamped) *clamped = 0;
-  const StopPoll stop(stopRequested);
+  // The work the loops below do, in frames loaded (StopPoll::advance), for the progress.
+  double work = 0.0;
+  {
+    const auto b = tiles(0, n, framesPerBlock);
+    for (std::size_t p = 0; p < b.size(); ++p) {
+      work += b[p].count;
+      for (std::size_t q = p; q < b.size(); ++q) {
+        if (q != p) work += b[q].count;
+        const auto tp = tiles(0, b[p].count, tileFrames), tq = tiles(0, b[q].count, tileFrames);
+        for (std::size_t i = 0; i < tp.size(); ++i)
+          for (std::size_t j = q == p ? i : 0; j < tq.size(); ++j) work += kEntryWork * tp[i].count * tq[j].count;
+      }
+    }
+  }
+  const StopPoll stop(stopRequested, progress, work);
   if (norm == RecurrenceNorm::L2) {
     return precision == GramPrecision::FloatChunked
                ? l2Distances<float>(series, framesPerBlock, tileFrames, clamped, stop)
@@ -360,7 +395,7 @@ RecurrenceMatrix computeOnce(const ScalarSeries& series, const RecurrenceOptions
   int blocks = 1;
   std::int64_t clamped = 0;
   const Eigen::MatrixXd D = distanceMatrix(series, options.norm, options.memoryBudgetBytes, options.tileFrames,
-                                           &blocks, &clamped, gram, options.stopRequested);
+                                           &blocks, &clamped, gram, options.stopRequested, options.progress);
   RecurrenceMatrix m = normaliseDistances(D);
   m.norm = options.norm;
   m.field = options.field;
@@ -434,15 +469,31 @@ void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatr
   if (H5Fclose(file.release()) < 0) throw RunError(databasePath + ": closing after writing the matrix failed");
 }
 
-std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
+namespace {
+/// The stored matrix's dataset if it is one of `expectedFrames` squared floats (an invalid handle
+/// otherwise); `file` receives the open file.
+hdf5::Handle storedMatrixSet(const std::string& databasePath, int expectedFrames, hdf5::Handle& file) {
   using hdf5::Handle;
   hdf5::silenceErrors();
-  Handle file(hdf5::openReadOnlyWaitingForWriter(databasePath));
-  if (!file.valid() || !hdf5::linkExists(file, layout::recurrenceMatrix)) return std::nullopt;
+  file = Handle(hdf5::openReadOnlyWaitingForWriter(databasePath));
+  if (!file.valid() || !hdf5::linkExists(file, layout::recurrenceMatrix)) return Handle();
   Handle set(H5Dopen2(file, layout::recurrenceMatrix, H5P_DEFAULT));
-  if (!set.valid() || hdf5::datasetClass(set) != H5T_FLOAT) return std::nullopt;
+  if (!set.valid() || hdf5::datasetClass(set) != H5T_FLOAT) return Handle();
   if (hdf5::datasetDims(set) != std::vector<hsize_t>{hsize_t(expectedFrames), hsize_t(expectedFrames)})
-    return std::nullopt;
+    return Handle();
+  return set;
+}
+}  // namespace
+
+bool hasStoredRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
+  hdf5::Handle file;
+  return storedMatrixSet(databasePath, expectedFrames, file).valid();
+}
+
+std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
+  hdf5::Handle file;
+  const hdf5::Handle set = storedMatrixSet(databasePath, expectedFrames, file);
+  if (!set.valid()) return std::nullopt;
   RecurrenceMatrix m;
   Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> R(expectedFrames, expectedFrames);
   if (H5Dread(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, R.data()) < 0) return std::nullopt;

@@ -87,6 +87,10 @@ struct RecurrenceOptions {
   /// thread-safe); true ends the computation with rcfd::Cancelled. A long database's matrix takes
   /// minutes. Empty: never.
   std::function<bool()> stopRequested = {};
+  /// Called as frames are loaded and tiles computed, from several threads (so it must be
+  /// thread-safe), with the fraction of the distance matrix's work done, non-decreasing and 1 at the
+  /// end of each computation (Auto's rare recomputation in double starts over). Empty: never.
+  std::function<void(double)> progress = {};
 };
 
 struct RecurrenceMatrix {
@@ -103,12 +107,13 @@ struct RecurrenceMatrix {
 };
 
 /// D(i, j) (before normalisation) for the series; `blocks` and `clamped` report the blocking and the
-/// negative round-off values clamped to 0; `stopRequested` as in RecurrenceOptions.
+/// negative round-off values clamped to 0; `stopRequested` and `progress` as in RecurrenceOptions.
 Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
                                std::int64_t memoryBudgetBytes, int tileFrames = 128,
                                int* blocks = nullptr, std::int64_t* clamped = nullptr,
                                GramPrecision precision = GramPrecision::Double,
-                               const std::function<bool()>& stopRequested = {});
+                               const std::function<bool()>& stopRequested = {},
+                               const std::function<void(double)>& progress = {});
 
 /// Eq. (6)-(7) from a distance matrix: R = 1 - D / max D (all ones if every D is 0).
 RecurrenceMatrix normaliseDistances(const Eigen::MatrixXd& D);
@@ -122,6 +127,8 @@ RecurrenceMatrix computeRecurrenceMatrix(const FieldDatabase& db, const Recurren
 void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatrix& matrix);
 /// The stored matrix if the file has one of shape [N][N] with N == expectedFrames.
 std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames);
+/// Whether loadRecurrenceMatrix() would find one, without reading it.
+bool hasStoredRecurrenceMatrix(const std::string& databasePath, int expectedFrames);
 
 /// A diagonal of R: lag k [frames] and the mean of R(i, i + k).
 struct RecurrenceLag {

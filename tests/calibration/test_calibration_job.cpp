@@ -11,6 +11,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -343,6 +346,73 @@ TEST(CalibrationJob, ResumeAfterInterruptionEqualsAnUninterruptedRun) {
   EXPECT_THROW(run(job, dir / "parallel", 200), Cancelled);
   EXPECT_EQ(withoutWallTime(run(job, dir / "parallel")), withoutWallTime(reference));
   expectSameResults(dir / "whole", dir / "parallel", 3);
+}
+
+/// The job run in this process with JSON progress on every report; returns the progress lines.
+std::vector<json> runWithProgress(const JobSpec& job, const fs::path& out, long stopAfter = -1) {
+  RunOptions o;
+  o.outDir = out.string();
+  o.stopAfterSteps = stopAfter;
+  o.progressJson = true;
+  o.progressInterval = 0.0;
+  testing::internal::CaptureStdout();
+  try {
+    runJob(job, o);
+  } catch (const Cancelled&) {
+  }
+  std::istringstream text(testing::internal::GetCapturedStdout());
+  std::vector<json> lines;
+  // In this process the log goes to stdout too (rcfd-solve sends it to stderr): only "{" lines are progress.
+  for (std::string line; std::getline(text, line);)
+    if (line.starts_with("{")) lines.push_back(json::parse(line));
+  return lines;
+}
+
+TEST(CalibrationJob, ProgressMovesInEveryPhaseAndAResumeStartsFromTheStepsDone) {
+  const fs::path dir = scratch("progress");
+  JobSpec job = makeJob(dir);
+  // One D0 at a time (a known split below), and the sweep as given (a sweep that grows has more to
+  // do, and its fraction drops when it does).
+  job.source = {{"calibration", {{"parallel", "tracers"}, {"extend_sweep", false}}}};
+  const auto lines = runWithProgress(job, dir / "whole");
+  ASSERT_FALSE(lines.empty());
+  std::vector<std::string> phases;
+  std::map<std::string, std::vector<double>> own;
+  double last = -1.0;
+  for (const auto& p : lines) {
+    EXPECT_GE(p.at("fraction").get<double>(), last) << p.dump();
+    last = p.at("fraction").get<double>();
+    const std::string phase = p.value("phase", "");
+    if (phases.empty() || phases.back() != phase) phases.push_back(phase);
+    if (p.contains("phase_fraction")) own[phase].push_back(p.at("phase_fraction").get<double>());
+  }
+  EXPECT_EQ(last, 1.0);
+  EXPECT_EQ(phases, (std::vector<std::string>{"recurrence", "runs", "report"}));
+  for (const char* phase : {"recurrence", "runs"}) {
+    const auto& f = own[phase];
+    ASSERT_FALSE(f.empty()) << phase;
+    EXPECT_TRUE(std::is_sorted(f.begin(), f.end())) << phase;
+    EXPECT_EQ(f.front(), 0.0) << phase;
+    EXPECT_EQ(f.back(), 1.0) << phase;
+    EXPECT_GT(std::set<double>(f.begin(), f.end()).size(), 10u) << phase;
+  }
+  // The runs, summed over D0: a third of the phase per D0 value.
+  EXPECT_NEAR(own["runs"][own["runs"].size() / 3], 1.0 / 3.0, 0.02);
+
+  // Interrupted in the second D0's run: the resumed process counts the finished run and the
+  // checkpoint's steps before anything runs, so its first line already says so.
+  runWithProgress(job, dir / "split", kSteps + 37);
+  const auto resumed = runWithProgress(job, dir / "split");
+  ASSERT_FALSE(resumed.empty());
+  const double stepsShare = double(kSteps + 37) / double(3 * kSteps);
+  EXPECT_EQ(resumed.front().at("phase"), "recurrence");
+  EXPECT_GT(resumed.front().at("fraction").get<double>(), 0.9 * stepsShare) << resumed.front().dump();
+  EXPECT_LT(resumed.front().at("fraction").get<double>(), stepsShare + 1e-9) << resumed.front().dump();
+  for (const auto& p : resumed) {
+    if (p.value("phase", "") != "runs") continue;
+    EXPECT_NEAR(p.at("phase_fraction").get<double>(), stepsShare, 1e-9) << "the first runs line: " << p.dump();
+    break;
+  }
 }
 
 TEST(CalibrationJob, BadInputNamesTheField) {

@@ -100,6 +100,56 @@ TEST(Bed, AStopRequestEndsTheFillingAtTheNextDemStep) {
   EXPECT_EQ(fillAndSettle(full, FillRegion{Vector3d(lo.x(), 0.05, lo.z()), hi}, 200, o).inserted, 200);
 }
 
+TEST(Bed, TheFillingReportsProgressThatMovesBeforeEveryDemStep) {
+  // A database job's progress through the filling (hours on a large bed) comes from here: it must
+  // move within each stage, never go back, and end at 1.
+  const double r = 1.5e-3;
+  const DemMaterial m = material(r, 0.9, 0.75, 0.5, 0.24, 0.06, 0.05, 5e5, 1040.0);
+  DemSettings s;
+  s.time_step = 0.25 * m.rayleighTime();
+  const Vector3d lo(-0.015, 0.0, 0.0), hi(0.015, 0.15, 0.03);
+  DemSystem dem(m, DemWalls::box(lo, hi), s);
+  FillOptions o;
+  o.max_settle_time = 0.05;
+  std::vector<double> inserting, settling;
+  std::vector<long> stepsAtCall;
+  o.progress = [&](FillStage stage, double f) {
+    (stage == FillStage::Inserting ? inserting : settling).push_back(f);
+    stepsAtCall.push_back(dem.steps());
+  };
+  // A region too small for the bed in one batch: the progress must carry over from batch to batch.
+  const FillResult result = fillAndSettle(dem, FillRegion{Vector3d(lo.x(), 0.1, lo.z()), hi}, 1500, o);
+  ASSERT_GE(result.batches, 2);
+  for (const auto* stage : {&inserting, &settling}) {
+    ASSERT_FALSE(stage->empty());
+    EXPECT_TRUE(std::is_sorted(stage->begin(), stage->end()));
+    EXPECT_EQ(stage->back(), 1.0);
+    EXPECT_GE(stage->front(), 0.0);
+    const std::size_t between = std::count_if(stage->begin(), stage->end(), [](double f) { return f > 0.0 && f < 1.0; });
+    EXPECT_GT(between, 100u);
+  }
+  EXPECT_EQ(inserting.front(), 0.0);
+  // 1 only once the last batch has fallen.
+  EXPECT_LT(*std::max_element(inserting.begin(), inserting.end() - 1), 1.0);
+  // Before every DEM step: no step without a call before it, from the first to the last.
+  EXPECT_EQ(stepsAtCall.front(), 0);
+  EXPECT_EQ(stepsAtCall.back(), dem.steps());
+  for (std::size_t k = 1; k < stepsAtCall.size(); ++k) ASSERT_LE(stepsAtCall[k] - stepsAtCall[k - 1], 1) << k;
+  // The fraction goes up steadily with the DEM steps, not in one jump per batch.
+  double largestJump = 0.0;
+  for (std::size_t k = 1; k < inserting.size(); ++k) largestJump = std::max(largestJump, inserting[k] - inserting[k - 1]);
+  EXPECT_LT(largestJump, 0.01);
+}
+
+TEST(Bed, SettleFractionFollowsTheTimeOrTheEnergyCriterionWhicheverIsAhead) {
+  EXPECT_DOUBLE_EQ(fillSettleFraction(0.1, 0.5, 1e-2, 1e-2, 1e-6), 0.2);     // time alone
+  EXPECT_NEAR(fillSettleFraction(0.01, 0.5, 1e-4, 1e-2, 1e-6), 0.5, 1e-12);   // halfway down on a log scale
+  EXPECT_DOUBLE_EQ(fillSettleFraction(0.4, 0.5, 1e-4, 1e-2, 1e-6), 0.8);     // time ahead
+  EXPECT_DOUBLE_EQ(fillSettleFraction(0.01, 0.5, 1e-6, 1e-2, 1e-6), 1.0);    // criterion met
+  EXPECT_DOUBLE_EQ(fillSettleFraction(0.01, 0.5, 2e-2, 1e-2, 1e-6), 0.02);   // energy above its start
+  EXPECT_DOUBLE_EQ(fillSettleFraction(0.7, 0.5, 1e-2, 1e-2, 1e-6), 1.0);     // time ran out
+}
+
 TEST(Bed, AStopRequestEndsTheInsertionOfALargeBatch) {
   // Inserting the parcels of a large bed is itself long (a million random positions, each tested
   // against the walls and its neighbours): the request is polled every kInsertionAttemptsPerPoll

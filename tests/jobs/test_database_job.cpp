@@ -12,8 +12,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <set>
 
 #include "analysis/ReferenceStatistics.hpp"
 #include "SolveProcess.hpp"
@@ -127,19 +129,40 @@ void expectCloseDatabase(const fs::path& a, const fs::path& b, double tolerance)
 }  // namespace
 
 TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
-  const SolveResult r = solve(run("a", "--progress-json"));
+  const SolveResult r = solve(run("a", "--progress-json --progress-interval 0"));
   ASSERT_EQ(r.exitCode, 0) << r.out;
-  // Progress: JSON lines, fraction non-decreasing up to 1.
+  // Progress: JSON lines, fraction non-decreasing up to 1, every phase named in order and moving:
+  // the whole job's fraction and the phase's own, from the filling on.
   std::istringstream lines(r.out);
   std::string line;
   double last = -1.0;
+  std::vector<std::string> phases;
+  std::map<std::string, std::vector<double>> fractions, phaseFractions;
   while (std::getline(lines, line)) {
     const json p = json::parse(line);
     ASSERT_TRUE(p.contains("fraction") && p.contains("eta_s") && p.contains("sim_time"));
     EXPECT_GE(p["fraction"].get<double>(), last);
     last = p["fraction"].get<double>();
+    const std::string phase = p.value("phase", "");
+    if (phases.empty() || phases.back() != phase) phases.push_back(phase);
+    fractions[phase].push_back(last);
+    if (p.contains("phase_fraction")) phaseFractions[phase].push_back(p["phase_fraction"].get<double>());
   }
   EXPECT_EQ(last, 1.0);
+  EXPECT_EQ(phases, (std::vector<std::string>{"fill", "settle", "warmup", "sample", "reference", "results"}));
+  for (const char* phase : {"fill", "settle", "warmup", "sample", "reference"}) {
+    const auto& f = fractions[phase];
+    const auto& own = phaseFractions[phase];
+    ASSERT_GT(f.size(), 10u) << phase;
+    EXPECT_GT(std::set<double>(f.begin(), f.end()).size(), 10u) << phase << ": the whole job's fraction moves";
+    ASSERT_GT(own.size(), 10u) << phase;
+    EXPECT_TRUE(std::is_sorted(own.begin(), own.end())) << phase;
+    EXPECT_GT(std::set<double>(own.begin(), own.end()).size(), 10u) << phase << ": the phase's fraction moves";
+    EXPECT_LE(own.front(), 0.2) << phase;
+    EXPECT_GE(own.back(), 0.8) << phase;
+  }
+  EXPECT_GT(fractions["fill"].back(), 0.0);
+  EXPECT_GT(fractions["settle"].back(), fractions["fill"].back());
 
   const json s = json::parse(std::ifstream(dir_ / "a" / "summary.json"));
   for (const char* key : {"kind", "status", "seed", "wall_time_s", "steps", "sim_time_s", "effects", "frames",

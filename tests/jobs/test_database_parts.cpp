@@ -17,12 +17,14 @@
 #include "analysis/SeriesSpectrum.hpp"
 #include "analysis/ZoneStays.hpp"
 #include "scene/DatabaseSchedule.hpp"
+#include "cfddem/CfdDemSimulation.hpp"
 #include "cfddem/DemSystem.hpp"
 #include "cfddem/ReferenceRecorder.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
 #include "fields/AnalyticDatabase.hpp"
 #include "geometry/Apparatus.hpp"
+#include "jobs/DatabaseProgress.hpp"
 #include "scene/SceneLoader.hpp"
 
 using nlohmann::json;
@@ -77,6 +79,41 @@ TEST(DatabaseSchedule, WholeStepsOfTheQuickScene) {
   EXPECT_DOUBLE_EQ(p.flowFactor(p.rampSteps / 4), 0.25);
   EXPECT_DOUBLE_EQ(p.flowFactor(p.rampSteps), 1.0);
   EXPECT_DOUBLE_EQ(p.flowFactor(10 * p.rampSteps), 1.0);
+}
+
+TEST(DatabaseProgress, PhasesJoinUpAndNameTheirOwnFraction) {
+  const rcfd::Scene s = rcfd::loadSceneFile(std::string(RCFD_SOURCE_DIR) + "/examples/quick.json");
+  const auto plan = rcfd::DatabaseSchedule::fromScene(s);
+  const rcfd::CfdDemSimulation sim(s, 1);
+  const rcfd::DatabaseProgress w(plan, s.dem.settle_time, rcfd::parcelsForBedMass(s), sim.fillFallSteps(),
+                                 sim.grid().cellCount(), sim.hasGas());
+  EXPECT_EQ(w.fill(0.0), 0.0);
+  EXPECT_DOUBLE_EQ(w.fill(1.0), w.settle(0.0));
+  EXPECT_DOUBLE_EQ(w.settle(1.0), w.coupled(0));
+  EXPECT_DOUBLE_EQ(w.coupled(plan.endOffset()), 1.0);
+  EXPECT_GT(w.fill(0.5), w.fill(0.25));
+  EXPECT_GT(w.settle(0.5), w.settle(0.25));
+  double last = 0.0;
+  for (std::int64_t k = 0; k <= 100; ++k) {
+    const double f = w.coupled(plan.endOffset() * k / 100);
+    EXPECT_GT(f, last - 1e-15);
+    last = f;
+  }
+  // The coupled steps cost the same throughout: equal steps, equal fractions.
+  EXPECT_NEAR(w.coupled(plan.rampSteps) - w.coupled(0), w.coupled(2 * plan.rampSteps) - w.coupled(plan.rampSteps), 1e-12);
+
+  EXPECT_STREQ(rcfd::coupledPhase(plan, 0), "ramp");
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, 0), 0.0);
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, plan.rampSteps / 2), 0.5);
+  EXPECT_STREQ(rcfd::coupledPhase(plan, plan.rampSteps), "warmup");
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, plan.rampSteps), 0.0);
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, plan.rampSteps + plan.warmupSteps / 4), 0.25);
+  const std::int64_t sampled = plan.frameOffset(plan.frames) - plan.frameOffset(0);
+  EXPECT_STREQ(rcfd::coupledPhase(plan, plan.frameOffset(0)), "sample");
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, plan.frameOffset(0) + sampled / 2), 0.5);
+  EXPECT_STREQ(rcfd::coupledPhase(plan, plan.frameOffset(plan.frames)), "reference");
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, plan.frameOffset(plan.frames)), 0.0);
+  EXPECT_DOUBLE_EQ(rcfd::coupledPhaseFraction(plan, plan.endOffset()), 1.0);
 }
 
 TEST(DatabaseSchedule, RefusesRatesThatMissDemStepsNamingTheField) {

@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sys/wait.h>
 
 #include "SolveProcess.hpp"
@@ -85,22 +87,38 @@ class SprayJob : public testing::Test {
 }  // namespace
 
 TEST_F(SprayJob, RunsAndReportsProgressAndTheContractKeys) {
-  const SolveResult r = solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "a").string() + " --progress-json");
+  const SolveResult r = solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "a").string() +
+                              " --progress-json --progress-interval 0");
   ASSERT_EQ(r.exitCode, 0) << r.out;
-  // Progress lines: one JSON object each, fraction rising to 1.
+  // Progress lines: one JSON object each, fraction rising to 1; the phases in order, the recurrence
+  // set-up (reading the frames, the matrix) and the run each moving on their own.
   std::istringstream lines(r.out);
   std::string line;
   double last = -1.0;
   int count = 0;
+  std::vector<std::string> phases;
+  std::map<std::string, std::vector<double>> own;
   while (std::getline(lines, line)) {
     const json p = json::parse(line);
     ASSERT_TRUE(p.contains("fraction") && p.contains("sim_time") && p.contains("wall_time") && p.contains("eta_s"));
     EXPECT_GE(p["fraction"].get<double>(), last);
     last = p["fraction"].get<double>();
     ++count;
+    const std::string phase = p.value("phase", "");
+    if (phases.empty() || phases.back() != phase) phases.push_back(phase);
+    if (p.contains("phase_fraction")) own[phase].push_back(p["phase_fraction"].get<double>());
   }
   EXPECT_GE(count, 1);
   EXPECT_EQ(last, 1.0);
+  EXPECT_EQ(phases, (std::vector<std::string>{"recurrence", "run", "results"}));
+  for (const char* phase : {"recurrence", "run"}) {
+    const auto& f = own[phase];
+    EXPECT_TRUE(std::is_sorted(f.begin(), f.end())) << phase;
+    EXPECT_GT(std::set<double>(f.begin(), f.end()).size(), 10u) << phase;
+    ASSERT_FALSE(f.empty());
+    EXPECT_EQ(f.front(), 0.0) << phase;
+    EXPECT_EQ(f.back(), 1.0) << phase;
+  }
   const json s = json::parse(std::ifstream(dir_ / "a" / "summary.json"));
   for (const char* key : {"kind", "status", "seed", "wall_time_s", "steps", "sim_time_s", "effects", "tracers",
                           "tracer_steps_per_s", "mass_balance", "overspray_fraction", "coverage",

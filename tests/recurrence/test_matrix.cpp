@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <atomic>
+#include <mutex>
+#include <vector>
 
 #include "../fields/FieldTestUtil.hpp"
 #include "core/Errors.hpp"
@@ -276,5 +279,40 @@ TEST(RecurrenceMatrix, AStopRequestEndsItBetweenTilesForEveryNormAndPrecision) {
     // Without a request the same options give the whole matrix.
     o.stopRequested = [] { return false; };
     EXPECT_EQ(computeRecurrenceMatrix(*db, o).R.rows(), frames) << toString(norm);
+  }
+}
+
+TEST(RecurrenceMatrix, ProgressRisesToOneThroughFramesAndTilesForEveryNormAndBlocking) {
+  // The calibration and spray jobs' "recurrence" phase moves by this: called from the threads that
+  // load frames and finish tiles, never backwards, 1 at the end, including blocked computations that
+  // load frames more than once.
+  const int frames = 60;
+  auto db = wavyDb(frames);
+  for (const auto& [norm, budget] : {std::pair{RecurrenceNorm::L2, std::int64_t(1) << 30},
+                                     std::pair{RecurrenceNorm::L2, std::int64_t(4000)},
+                                     std::pair{RecurrenceNorm::L1, std::int64_t(4000)}}) {
+    std::mutex m;
+    std::vector<double> seen;
+    RecurrenceOptions o;
+    o.norm = norm;
+    o.gram = GramPrecision::Double;
+    o.memoryBudgetBytes = budget;
+    o.tileFrames = 4;
+    o.progress = [&](double f) {
+      std::lock_guard lock(m);
+      seen.push_back(f);
+    };
+    const RecurrenceMatrix r = computeRecurrenceMatrix(*db, o);
+    ASSERT_EQ(r.R.rows(), frames);
+    ASSERT_FALSE(seen.empty()) << toString(norm);
+    // Reports from several threads may arrive out of order by a unit; the largest is the end.
+    EXPECT_DOUBLE_EQ(*std::max_element(seen.begin(), seen.end()), 1.0) << toString(norm) << " " << budget;
+    for (double f : seen) EXPECT_TRUE(f > 0.0 && f <= 1.0) << f;
+    // Many steps on the way: every frame and tile pair moves it.
+    EXPECT_GT(seen.size(), std::size_t(frames)) << toString(norm);
+    // The frames' loads are a small part: the fraction after the first `frames` calls is well below 1.
+    std::vector<double> sorted = seen;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_LT(sorted[std::size_t(frames) - 1], 0.9) << toString(norm) << " " << budget;
   }
 }

@@ -192,6 +192,9 @@ TEST_F(EndToEnd, UploadSprayCoverageCsvAndH5EqualResultH5) {
   const auto job = server->get("/v1/jobs/" + id).json();
   ASSERT_EQ(job.at("state"), "SUCCEEDED") << job.dump(2);
   EXPECT_DOUBLE_EQ(job.at("progress").at("fraction").get<double>(), 1.0);
+  // The phase belongs to a running job.
+  EXPECT_TRUE(job.at("progress").at("phase").is_null()) << job.dump(2);
+  EXPECT_TRUE(job.at("progress").at("phase_fraction").is_null()) << job.dump(2);
   const auto result = client(*server, {"result", id});
   ASSERT_EQ(result.code, 0);
   EXPECT_EQ(nlohmann::json::parse(result.out).at("kind"), "spray");
@@ -434,19 +437,23 @@ TEST_F(EndToEnd, CancelDuringTheDemFillEndsCancelledWithinSecondsWithoutSigkill)
       {"probes", {{{"name", "bed"}, {"position", {0.0025, 0.0025, 0.0075}}}}},
       {"effects", {"rolling_friction"}}};
   const std::string id = submit(*server, {{"kind", "database"}, {"scene", scene}, {"seed", 3}});
-  // In the fill: the solver reports DEM time while the fraction stays 0 (the fill is the only such phase).
+  // In the fill: the job resource names the phase, and the solver's DEM time and the fill's own
+  // progress move from the first steps.
   const auto filling = pollJob(*server, id, [](const nlohmann::json& j) {
     const auto& p = j.at("progress");
-    return j.at("state") == "RUNNING" && p.at("sim_time").is_number() && p.at("sim_time").get<double>() > 0.0 &&
-           p.at("fraction").get<double>() == 0.0;
+    return j.at("state") == "RUNNING" && p.at("phase") == "fill" && p.at("sim_time").is_number() &&
+           p.at("sim_time").get<double>() > 0.0;
   });
   ASSERT_EQ(filling.at("state"), "RUNNING") << filling.dump(2) << server->stderrText();
+  EXPECT_GT(filling.at("progress").at("phase_fraction").get<double>(), 0.0) << filling.dump(2);
+  EXPECT_GT(filling.at("progress").at("fraction").get<double>(), 0.0) << filling.dump(2);
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(server->post("/v1/jobs/" + id + ":cancel", "").status, 202);
   const auto done = pollJob(*server, id, isFinal);
   const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   RecordProperty("seconds_to_cancelled", std::to_string(waited));
   EXPECT_EQ(done.at("state"), "CANCELLED") << done.dump(2);
+  EXPECT_TRUE(done.at("progress").at("phase").is_null()) << done.dump(2);
   EXPECT_LT(waited, 5.0 + 1.0);
   const auto events = server->get("/v1/jobs/" + id + "/events").json().at("events");
   ASSERT_FALSE(events.empty());

@@ -380,10 +380,11 @@ CREATE TABLE databases (id TEXT PRIMARY KEY, path TEXT NOT NULL, bytes INTEGER N
   {
     ServerProcess server(data, "single-token");
     const auto health = server.get("/v1/health").json();
-    EXPECT_EQ(health.at("schema_version"), 3);
+    EXPECT_EQ(health.at("schema_version"), 4);  // users (3), then the running job's phase (4)
     const auto job = server.get("/v1/jobs/" + oldJob);
     ASSERT_EQ(job.status, 200) << job.body;
     EXPECT_EQ(job.json().at("owner"), "admin");
+    EXPECT_TRUE(job.json().at("progress").at("phase").is_null()) << job.body;
     EXPECT_EQ(server.get("/v1/databases/" + oldDb).json().at("owner"), "admin");
     // The old Idempotency-Key is still the (single token's) admin's: another body under it is refused
     // naming the old job.
@@ -392,7 +393,7 @@ CREATE TABLE databases (id TEXT PRIMARY KEY, path TEXT NOT NULL, bytes INTEGER N
     EXPECT_NE(reused.body.find(oldJob), std::string::npos) << reused.body;
     EXPECT_EQ(server.post("/v1/jobs", databaseJob(6).dump()).json().at("owner"), "admin");
   }
-  EXPECT_EQ(sqliteInt(store, "SELECT version FROM schema_version"), 3);
+  EXPECT_EQ(sqliteInt(store, "SELECT version FROM schema_version"), 4);
   EXPECT_EQ(sqliteInt(store, "SELECT COUNT(*) FROM jobs WHERE owner = 'admin'"), 2);
   EXPECT_EQ(sqliteInt(store, "SELECT COUNT(*) FROM databases WHERE owner = 'admin'"), 1);
 
