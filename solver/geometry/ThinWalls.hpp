@@ -29,10 +29,14 @@ struct BaffleFaces {
     const auto& s = shape[std::size_t(d)];
     return (std::size_t(k) * s[1] + j) * s[0] + i;
   }
-  /// True when the face of axis d at face index (i, j, k) is wholly covered: nothing crosses it.
+  /// True when the face of axis d at face index (i, j, k) is wholly covered: nothing crosses it. An index
+  /// outside the face array (a stencil reaching past the domain's edge) is no baffle: the outer walls
+  /// are handled by the ghost cells.
   bool closes(int d, int i, int j, int k) const {
     const auto& c = covered[std::size_t(d)];
-    return !c.empty() && c[index(d, i, j, k)] >= 1.0;
+    const auto& s = shape[std::size_t(d)];
+    if (c.empty() || i < 0 || j < 0 || k < 0 || i >= s[0] || j >= s[1] || k >= s[2]) return false;
+    return c[index(d, i, j, k)] >= 1.0;
   }
 };
 

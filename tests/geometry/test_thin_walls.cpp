@@ -45,6 +45,21 @@ TEST(ThinWalls, PlateInsideACellColumnClosesItsNearestFace) {
   EXPECT_FALSE(b.closes(1, 30, 10, 0));
 }
 
+TEST(ThinWalls, AFaceIndexPastTheDomainsEdgeIsNoBaffle) {
+  // The gas solver's stencils ask for faces one and two cells beyond the domain's edge (the outer
+  // walls are its ghost cells): such an index is no baffle and is never read from the face array.
+  const Apparatus app(slice(true));
+  const BaffleFaces b = thinWallBaffles(app, sliceGrid(app, 0.005));
+  ASSERT_TRUE(b.closes(0, 30, 10, 0));
+  EXPECT_FALSE(b.closes(0, 30, 10, -1));
+  EXPECT_FALSE(b.closes(0, 30, 10, 4));
+  EXPECT_FALSE(b.closes(0, -1, 10, 0));
+  EXPECT_FALSE(b.closes(0, 51, 10, 0));
+  EXPECT_FALSE(b.closes(1, 50, 10, 0));
+  EXPECT_FALSE(b.closes(1, 10, 121, 0));
+  EXPECT_FALSE(b.closes(2, 10, 10, 0));
+}
+
 TEST(ThinWalls, PartlyCoveredFaceAtAPlateTipIsNotClosed) {
   ApparatusSpec spec = slice(true);
   spec.draft_plates->elevation = 0.037;  // lower edge 3 mm into the row [0.035, 0.040]
