@@ -60,6 +60,16 @@ nlohmann::json stayComparison(const JobSpec& job, const Scene& scene, const std:
       .toJson();
 }
 
+/// Opens the recurrence set-up's phase of a run that has `priorWall` seconds and `startFraction` of its
+/// work behind it (a resumed job): its first line, at once, and the ETA counted from this process on.
+void beginRecurrencePhase(ProgressReporter& progress, double priorWall, double startFraction) {
+  progress.setPriorWallTime(priorWall);
+  progress.setStartFraction(startFraction);
+  progress.setPhase("recurrence");
+  progress.setPhaseFraction(0.0);
+  progress.report(startFraction, 0.0, true);
+}
+
 /// The run's coverage distribution against the full simulation's over the same duration
 /// (analysis/CoverageComparison.hpp); null without coverage or without a reference coverage.
 nlohmann::json coverageComparison(const JobSpec& job, const Scene& scene, const std::string& resultPath,
@@ -156,11 +166,7 @@ class TracerJob final : public JobRunner {
     const TracerJobWork work(recurrenceWork(scene, job.database), double(steps) * double(scene.rcfd.tracers));
     const double tracers = double(scene.rcfd.tracers);
     ProgressReporter progress(options.progressJson, options.progressInterval);
-    progress.setPriorWallTime(priorWall);
-    progress.setStartFraction(work.fraction(0.0, double(resumedStep) * tracers));
-    progress.setPhase("recurrence");
-    progress.setPhaseFraction(0.0);
-    progress.report(work.fraction(0.0, double(resumedStep) * tracers), 0.0, true);
+    beginRecurrencePhase(progress, priorWall, work.fraction(0.0, double(resumedStep) * tracers));
 
     // The path is indexed per frame; dt may divide dt_rec, so size it for the number of frames used.
     RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed,
@@ -272,11 +278,7 @@ class TracerJob final : public JobRunner {
     const double tracers = double(scene.rcfd.tracers);
     const TracerJobWork work(recurrenceWork(scene, job.database), totalSteps * tracers);
     ProgressReporter progress(options.progressJson, options.progressInterval);
-    progress.setPriorWallTime(priorWall);
-    progress.setStartFraction(work.fraction(0.0, double(stepsDone) * tracers));
-    progress.setPhase("recurrence");
-    progress.setPhaseFraction(0.0);
-    progress.report(work.fraction(0.0, double(stepsDone) * tracers), 0.0, true);
+    beginRecurrencePhase(progress, priorWall, work.fraction(0.0, double(stepsDone) * tracers));
     // One matrix and database for all; member 0's path is the job seed's, the others draw their own.
     RecurrenceSetup rec = prepareRecurrence(scene, job.database, steps + 2, job.seed,
                                             [] { return cancellationRequested(); },
