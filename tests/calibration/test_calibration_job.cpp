@@ -4,6 +4,8 @@
 // independence, missing and present reference statistics, and resume after an interruption.
 #include <gtest/gtest.h>
 
+#include "../BitIdentical.hpp"
+
 #include <algorithm>
 #include <unistd.h>
 
@@ -128,7 +130,7 @@ void expectSameResults(const fs::path& a, const fs::path& b, std::size_t runs) {
     ASSERT_TRUE(fb.exists(name)) << name;
     const auto va = fa.readDoubles(name), vb = fb.readDoubles(name);
     ASSERT_EQ(va.size(), vb.size()) << name;
-    EXPECT_EQ(0, std::memcmp(va.data(), vb.data(), va.size() * sizeof(double))) << name;
+    EXPECT_TRUE(rcfd::test::bitIdentical(va, vb)) << name;
   }
 }
 

@@ -1,6 +1,8 @@
 // The engine's contracts: effects built only when asked for, clear errors, bit-identical results for
 // any thread count and across checkpoint/resume, and robustness over a million steps.
 #include <gtest/gtest.h>
+
+#include "../BitIdentical.hpp"
 #include <omp.h>
 
 #include <cstring>
@@ -78,9 +80,7 @@ RunResult runFor(const Scene& s, std::shared_ptr<FieldDatabase> db, std::int64_t
   return r;
 }
 
-bool bitIdentical(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
+using rcfd::test::bitIdentical;
 }  // namespace
 
 TEST(Effects, NotAskedForIsNotBuiltNorAllocated) {

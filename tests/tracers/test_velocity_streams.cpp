@@ -5,6 +5,8 @@
 // bit-identical for 1 and 2 threads and across a resume; a scene without the effect runs as before and
 // allocates nothing for it.
 #include <gtest/gtest.h>
+
+#include "../BitIdentical.hpp"
 #include <omp.h>
 
 #include <cmath>
@@ -187,7 +189,7 @@ TEST(VelocityStreams, OneAndTwoThreadsAndAResumeAreBitIdentical) {
   const Outcome two = run(s, db, 60, 10, 2);
   const Outcome resumed = run(s, db, 60, 10, 2, 23);
   for (const Outcome* o : {&two, &resumed}) {
-    EXPECT_EQ(std::memcmp(one.cloud.y.data(), o->cloud.y.data(), one.cloud.y.size() * sizeof(double)), 0);
+    EXPECT_TRUE(rcfd::test::bitIdentical(one.cloud.y, o->cloud.y));
     EXPECT_EQ(one.summary.dump(), o->summary.dump());
   }
 }
@@ -205,7 +207,7 @@ TEST(VelocityStreams, ASceneWithoutItRunsAsBeforeAndAllocatesNothing) {
   });
   const Outcome a = run(s, withSpread, 80, 10);
   const Outcome b = run(s, without, 80, 10);
-  EXPECT_EQ(std::memcmp(a.cloud.y.data(), b.cloud.y.data(), a.cloud.y.size() * sizeof(double)), 0);
+  EXPECT_TRUE(rcfd::test::bitIdentical(a.cloud.y, b.cloud.y));
   EXPECT_EQ(a.summary.dump(), b.summary.dump());
   EXPECT_FALSE(a.summary.contains("velocity_streams"));
   TracerSimulation sim(s, without, sequentialPath(20, 10), {1, 5, 0});
