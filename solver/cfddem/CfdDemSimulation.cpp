@@ -198,6 +198,17 @@ std::vector<Eigen::Vector3d> CfdDemSimulation::particleVelocity() const {
   return map.meanVelocity(dem_->particles(), w);
 }
 
+std::vector<char> CfdDemSimulation::cellsHoldingParcels() const {
+  const auto& map = coupling_->map();
+  std::vector<coupling::KernelWeights> w;
+  std::vector<double> volume;
+  map.weightsOf(dem_->particles(), w);
+  map.scatterVolume(dem_->particles(), w, volume);
+  std::vector<char> holds(volume.size());
+  for (std::size_t c = 0; c < volume.size(); ++c) holds[c] = volume[c] > 0.0;
+  return holds;
+}
+
 coupling::VolumeMapping::VelocitySpread CfdDemSimulation::particleVelocitySpread() const {
   const auto& map = coupling_->map();
   std::vector<coupling::KernelWeights> w;

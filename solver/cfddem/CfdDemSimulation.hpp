@@ -90,6 +90,9 @@ class CfdDemSimulation {
   std::vector<double> particleFraction() const;
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> particleVelocity() const;
+  /// 1 for the cells a parcel maps volume to (before smoothing): those particleVelocity() is the
+  /// velocity of; a cell with alpha_P > 0 and 0 here got its volume from the smoothing alone.
+  std::vector<char> cellsHoldingParcels() const;
   /// The velocity spread of the same instant (VolumeMapping::velocitySpread): up share, the mean velocity
   /// of the up- and down-moving volume, the variance per component.
   coupling::VolumeMapping::VelocitySpread particleVelocitySpread() const;

@@ -11,6 +11,7 @@
 #include "fields/FieldDatabase.hpp"
 #include "fields/FieldValidation.hpp"
 #include "fields/FrameCache.hpp"
+#include "fields/VelocityCompletion.hpp"
 #include "fields/Hdf5.hpp"
 
 namespace rcfd {
@@ -69,6 +70,7 @@ struct FrameReader {
   Handle alphaP, uP, uG;
   Handle spread[std::size(kVelocitySpreadFields)];  ///< read when valid (FrameStorage::velocitySpread)
   CartesianGrid grid;
+  std::vector<float> openFraction;  ///< /grid/fluid_fraction
   std::string path;
   mutable std::mutex io;
 
@@ -108,6 +110,7 @@ struct FrameReader {
       }
     }
     checkFrame(*frame, index, grid, path);  // NaN/Inf: refused when the frame is read
+    completeParticleVelocity(grid, openFraction, cellsWithParticleVolume(*frame), *frame, 1);
     return frame;
   }
 };
@@ -275,6 +278,7 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   }
   Header h = readHeader(reader->file, path);
   reader->grid = h.grid;
+  reader->openFraction = h.fluidFraction;
   reader->path = path;
 
   std::vector<Violation> v;
@@ -365,6 +369,7 @@ std::shared_ptr<FieldDatabase> makeInMemoryDatabase(const CartesianGrid& grid,
                        "frame " + std::to_string(i) + (h.velocitySpread ? " lacks" : " has") +
                            " the velocity spread that frame 0 " + (h.velocitySpread ? "has" : "lacks"));
     }
+    completeParticleVelocity(grid, h.fluidFraction, cellsWithParticleVolume(frames[i]), frames[i], 1);
     shared.push_back(std::make_shared<const FieldFrame>(std::move(frames[i])));
   }
   return std::make_shared<InRamDatabase>(std::move(h), std::move(shared));

@@ -33,6 +33,7 @@
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
 #include "fields/FieldDatabase.hpp"
+#include "fields/VelocityCompletion.hpp"
 #include "jobs/Cancellation.hpp"
 #include "jobs/DatabaseProgress.hpp"
 #include "jobs/JobRunner.hpp"
@@ -69,23 +70,30 @@ std::vector<float> interleaved(const std::vector<Eigen::Vector3d>& values) {
   return out;
 }
 
+/// Layers of cells around the parcels that the smoothing of Eq. (3) gives particle volume and the
+/// frame its velocity (VelocityCompletion.hpp): the smoothing length is below a cell, so three layers
+/// reach all but a negligible share of the smoothed volume.
+constexpr int kSmoothedLayers = 3;
+
 /// A frame of the current instant; with the velocity spread when `withSpread` (a scene whose tracer
-/// effects read it: 17 floats per cell instead of 7, on disk and in every reader's memory).
-FieldFrame sampleFrame(const CfdDemSimulation& sim, bool withSpread) {
+/// effects read it: 17 floats per cell instead of 7, on disk and in every reader's memory). Cells that
+/// only the smoothing gave particle volume get the velocity of the volume next to them.
+FieldFrame sampleFrame(const CfdDemSimulation& sim, const std::vector<float>& openFraction, bool withSpread) {
   FieldFrame f;
   const auto alpha = sim.particleFraction();
   f.alpha_p.assign(alpha.begin(), alpha.end());
   f.u_g = interleaved(sim.gasVelocity());
   if (!withSpread) {
     f.u_p = interleaved(sim.particleVelocity());
-    return f;
+  } else {
+    const auto spread = sim.particleVelocitySpread();
+    f.u_p = interleaved(spread.mean);
+    f.up_fraction.assign(spread.upFraction.begin(), spread.upFraction.end());
+    f.u_p_up = interleaved(spread.up);
+    f.u_p_down = interleaved(spread.down);
+    f.u_p_variance = interleaved(spread.variance);
   }
-  const auto spread = sim.particleVelocitySpread();
-  f.u_p = interleaved(spread.mean);
-  f.up_fraction.assign(spread.upFraction.begin(), spread.upFraction.end());
-  f.u_p_up = interleaved(spread.up);
-  f.u_p_down = interleaved(spread.down);
-  f.u_p_variance = interleaved(spread.variance);
+  completeParticleVelocity(sim.grid(), openFraction, sim.cellsHoldingParcels(), f, kSmoothedLayers);
   return f;
 }
 
@@ -211,7 +219,7 @@ class DatabaseJob final : public JobRunner {
       const std::int64_t offset = sim.demStep() - st.settledStep;
       progress.setPhase(coupledPhase(plan, offset));
       if (st.framesWritten < plan.frames && offset == plan.frameOffset(st.framesWritten)) {
-        const FieldFrame frame = sampleFrame(sim, writer->writesVelocitySpread());
+        const FieldFrame frame = sampleFrame(sim, fluid, writer->writesVelocitySpread());
         const ForcedExitDeferral keepTheDatabaseReadable;
         writer->append(frame);
         ++st.framesWritten;
@@ -220,7 +228,7 @@ class DatabaseJob final : public JobRunner {
         // The reference coverage steps from every sample of the reference period to the next.
         if (coverage && rec->samples() >= plan.sampledSamples()) {
           const DemParticles& parcels = sim.dem().particles();
-          coverage->step(parcels.x, parcels.id, std::make_shared<const FieldFrame>(sampleFrame(sim, false)));
+          coverage->step(parcels.x, parcels.id, std::make_shared<const FieldFrame>(sampleFrame(sim, fluid, false)));
         }
         rec->record(sim.particleVelocity(), sim.pressureDrop(), sim.dem().particles());
         const DemParticles& p = sim.dem().particles();

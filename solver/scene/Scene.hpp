@@ -140,6 +140,9 @@ struct RcfdSpec {
   std::string fluctuation_model = "lichtenegger_pirker";  ///< or "cfdem"
   double max_courant = 1.0;         ///< particle Courant number bound for sub-stepping [-]
   std::string integrator = "midpoint";  ///< Eq. (9) time integration: "midpoint" (2nd order) or "euler"
+  /// Fields between two frames when dt < dt_rec: "hold" (each frame over its whole interval) or
+  /// "linear" (the two frames blended)
+  std::string frame_interpolation = "hold";
   long frame_cache_bytes = 0;       ///< 0: load all frames into RAM; else LRU cache size [bytes]
   PathSpec path;
 };

@@ -11,6 +11,7 @@
 #include "core/Permutation.hpp"
 #include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
+#include "tracers/FrameInterpolation.hpp"
 
 namespace rcfd {
 
@@ -20,6 +21,7 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   const double dtRec = database_->dtRec();
   const double ratio = dtRec / scene_.rcfd.dt;
   stepsPerFrame_ = int(std::lround(ratio));
+  linearBetweenFrames_ = frameInterpolation(scene_) == FrameInterpolation::Linear;
   if (!(scene_.rcfd.dt > 0.0) || stepsPerFrame_ < 1 || std::abs(ratio - stepsPerFrame_) > 1e-6 * ratio) {
     throw InputError("scene", "/rcfd/dt",
                      std::to_string(scene_.rcfd.dt) + " s must be dt_rec / k for a whole number k >= 1 (dt_rec = " +
@@ -81,8 +83,10 @@ void TracerSimulation::frameAt(std::int64_t step, int& frame, int& next, double&
   frame = path_.frames[std::size_t(index)];
   next = frame;
   blend = 0.0;
-  // Interpolate only inside a sequence: never across a jump of the path.
-  if (sub > 0 && !path_.isJump(index + 1)) {
+  // Blend only inside a sequence: never across a jump of the path. Holding a frame is the default:
+  // a structure that moves between two frames blends into two weaker ones, and tracers in either
+  // move slower than the particles did (docs/accuracy.md, "Between frames").
+  if (linearBetweenFrames_ && sub > 0 && !path_.isJump(index + 1)) {
     next = path_.frames[std::size_t(index + 1)];
     blend = double(sub) / stepsPerFrame_;
   }

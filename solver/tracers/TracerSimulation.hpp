@@ -95,6 +95,7 @@ class TracerSimulation {
   std::vector<std::unique_ptr<TracerEffect>> effects_;
   std::unique_ptr<MotionKernel> kernel_;
   int stepsPerFrame_ = 1;
+  bool linearBetweenFrames_ = false;  ///< scene rcfd.frame_interpolation "linear"
   std::vector<double> effectSeconds_;  ///< per effect, in effects_' order
   double motionSeconds_ = 0.0, frameSeconds_ = 0.0, sortSeconds_ = 0.0;
   bool keepsVelocities_ = false;  ///< free_flight: the cloud's velocities are state

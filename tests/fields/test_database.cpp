@@ -190,7 +190,8 @@ TEST(FieldDatabase, LoadsAFileWrittenByAnotherProgram) {
       for (int c = 0; c < 12; ++c) {
         ASSERT_EQ(f->alpha_p[std::size_t(c)], rawValue(n, c, 0));
         for (int d = 0; d < 3; ++d) {
-          ASSERT_EQ(f->u_p[std::size_t(3 * c + d)], rawValue(n, c, d + 1));
+          // Where alpha_P is 0 the reader completes u_P (test_velocity_completion.cpp).
+          if (f->alpha_p[std::size_t(c)] > 0.0f) ASSERT_EQ(f->u_p[std::size_t(3 * c + d)], rawValue(n, c, d + 1));
           ASSERT_EQ(f->u_g[std::size_t(3 * c + d)], -rawValue(n, c, d + 1));
         }
       }

@@ -19,6 +19,7 @@
 #include "scene/SchemaValidator.hpp"
 #include "spray/DepositionEfficiency.hpp"
 #include "tracers/FluctuationModel.hpp"
+#include "tracers/FrameInterpolation.hpp"
 #include "tracers/TracerIntegrator.hpp"
 
 namespace rcfd {
@@ -57,6 +58,7 @@ TEST(Choices, SceneSchemaEnumsAreTheRegisteredNames) {
   EXPECT_EQ(schemaEnum("scene", p + "gas/properties/drag_model"), coupling::DragModelRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "gas/properties/pressure_preconditioner"), gas::PreconditionerRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/integrator"), namesOf(kTracerIntegrators));
+  EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/frame_interpolation"), namesOf(kFrameInterpolations));
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/fluctuation_model"), FluctuationModelRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/path/properties/type"), PathGeneratorRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "spray/properties/deposition_model"), DepositionModelRegistry::names());
@@ -91,6 +93,12 @@ TEST(Choices, UnknownIntegratorAndNormAreInputErrorsNamingTheValidOnes) {
   for (const auto& i : kTracerIntegrators) {
     s.rcfd.integrator = i.name;
     EXPECT_EQ(tracerIntegrator(s), i.value);
+  }
+  s.rcfd.frame_interpolation = "cubic";
+  expectUnknownNameAt([&] { frameInterpolation(s); }, "/rcfd/frame_interpolation", {"hold", "linear"});
+  for (const auto& i : kFrameInterpolations) {
+    s.rcfd.frame_interpolation = i.name;
+    EXPECT_EQ(frameInterpolation(s), i.value);
   }
 }
 
