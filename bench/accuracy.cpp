@@ -11,7 +11,7 @@
 //     spread beside them, so that statistical and systematic error are told apart.
 // Knobs: tracer count, rCFD time step, integrator, tracer motion model, D0, free flight, sub-steps, and
 // the database's sampling rate and length (subsampled copies of the database: every k-th frame, the
-// first frames). The database's own cost (cell size, coarse graining) is a database job per setting and
+// first frames), with the frames between two held or blended (rcfd.frame_interpolation). The database's own cost (cell size, coarse graining) is a database job per setting and
 // is not part of this ladder (docs/accuracy.md).
 // Writes OUT/accuracy.json (every run), OUT/accuracy.md (tables), OUT/accuracy-stays.svg and
 // OUT/accuracy-coverage.svg (error against wall time, one curve per knob, the Pareto front marked).
@@ -367,10 +367,15 @@ json runAccuracy(const Options& options) {
   if (withoutEffect(effects, "free_flight") != effects)
     add("free_flight", "off", {{"effects", withoutEffect(effects, "free_flight")}});
   add("sub_steps", "off", {{"rcfd", {{"max_courant", 1e6}}}});
-  for (int stride : {2, 4}) {
+  const std::string rule = rcfd.value("frame_interpolation", "hold");
+  const std::string otherRule = rule == "linear" ? "hold" : "linear";
+  for (int stride : {2, 4, 10}) {
     const std::string db = (out / ("database-every" + std::to_string(stride) + ".h5")).string();
     writeSubsampledDatabase(database, db, stride, frames);
-    add("sampling", formatNumber(1.0 / (dtRec * stride)) + "Hz", json::object(), db);
+    const std::string rate = formatNumber(1.0 / (dtRec * stride)) + "Hz";
+    add("sampling", rate, json::object(), db);
+    // Between two sparse frames the scene's rule against the other one, at the scene's step.
+    add("between_frames", otherRule + "-" + rate, {{"rcfd", {{"frame_interpolation", otherRule}}}}, db);
     // The longest rCFD step a database allows is its interval: twice the scene's step on every second
     // frame (the step and the sampling rate change together; compare with that sampling row).
     if (stride == 2 && std::fabs(dtRec * stride - baseDt) > 1e-12)

@@ -88,6 +88,17 @@ std::int64_t completeParticleVelocity(const CartesianGrid& grid, const std::vect
     }
     completed += std::int64_t(layer.size());
   }
+  // Out of reach of any particle volume: no velocity, whatever the file held there.
+  for (std::size_t c = 0; c < holdsVelocity.size(); ++c) {
+    if (holdsVelocity[c] || !(openFraction[c] > 0.0f)) continue;
+    for (int d = 0; d < 3; ++d) frame.u_p[3 * c + std::size_t(d)] = 0.0f;
+    if (!spread) continue;
+    frame.up_fraction[c] = 0.0f;
+    for (int d = 0; d < 3; ++d) {
+      frame.u_p_up[3 * c + std::size_t(d)] = frame.u_p_down[3 * c + std::size_t(d)] = 0.0f;
+      frame.u_p_variance[3 * c + std::size_t(d)] = 0.0f;
+    }
+  }
   return completed;
 }
 

@@ -25,8 +25,9 @@ namespace rcfd {
 
 /// Completes u_P (and the velocity spread, when the frame has it) of the open cells (phi > 0) with
 /// holdsVelocity == 0 that touch one with holdsVelocity != 0 and alpha_P > 0, for up to `layers`
-/// layers: a completed cell with alpha_P > 0 passes its velocity on to the next layer. Cells that
-/// hold velocity and solid cells are left as they are. Returns the number of cells completed.
+/// layers: a completed cell with alpha_P > 0 passes its velocity on to the next layer. The open cells
+/// without velocity out of reach get 0; cells that hold velocity and solid cells are left as they
+/// are. Returns the number of cells completed.
 std::int64_t completeParticleVelocity(const CartesianGrid& grid, const std::vector<float>& openFraction,
                                       std::vector<char> holdsVelocity, FieldFrame& frame, int layers);
 

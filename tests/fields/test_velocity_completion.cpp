@@ -51,6 +51,7 @@ TEST(VelocityCompletion, AnEmptyCellTakesTheVolumeWeightedVelocityOfItsNeighbour
   Slab s(false);
   s.occupy(0, 0, 0.3f, Vec3(1.0, 2.0, 0.0));
   s.occupy(1, 1, 0.1f, Vec3(-1.0, 6.0, 0.5));
+  s.frame.u_p[3 * s.cell(3, 0)] = 7.0f;  // what a file may hold where there are no particles
   const FieldFrame before = s.frame;
   const auto completed = completeParticleVelocity(s.grid, s.open, cellsWithParticleVolume(s.frame), s.frame, 1);
   // Cell (1, 0) touches both: (0.3 (1, 2, 0) + 0.1 (-1, 6, 0.5)) / 0.4.
@@ -58,7 +59,7 @@ TEST(VelocityCompletion, AnEmptyCellTakesTheVolumeWeightedVelocityOfItsNeighbour
   EXPECT_FLOAT_EQ(s.frame.u_p[3 * both], 0.5f);
   EXPECT_FLOAT_EQ(s.frame.u_p[3 * both + 1], 3.0f);
   EXPECT_FLOAT_EQ(s.frame.u_p[3 * both + 2], 0.125f);
-  // Cell (2, 2) touches (1, 1) only; (3, 0) and (3, 1) touch nothing occupied and stay 0.
+  // Cell (2, 2) touches (1, 1) only; (3, 0) and (3, 1) touch nothing occupied and have no velocity.
   EXPECT_FLOAT_EQ(s.frame.u_p[3 * s.cell(2, 2) + 1], 6.0f);
   for (const auto c : {s.cell(3, 0), s.cell(3, 1)})
     for (int d = 0; d < 3; ++d) EXPECT_EQ(s.frame.u_p[3 * c + std::size_t(d)], 0.0f);
