@@ -50,10 +50,14 @@ class CirculatingBed {
   static constexpr double kPulse = 0.25, kPeriod = 0.5;  ///< circulation rate's pulse [-], period [s]
   static constexpr int kModes = 3;
   static constexpr double kFeedModeAmplitude = 0.4, kAnnulusModeAmplitude = 0.3;  ///< of modes 1, 2 [-]
-  static constexpr double kStrayFall = -1.0;          ///< u_P above the circulation (alpha_P^rec 0) [m/s]
+  static constexpr double kStrayFall = -1.0;          ///< u_P above the circulation [m/s]
+  /// alpha_P above the circulation: a trace of particles falling back, so that the frames carry their
+  /// velocity there (the reader completes u_P only where alpha_P is 0: VelocityCompletion.hpp) [-]
+  static constexpr float kStrayAlpha = 1e-6f;
 
   /// `open`: open fraction of each cell (openFractions()).
-  CirculatingBed(const Scene& scene, const CartesianGrid& grid, const std::vector<float>& open) : grid_(grid) {
+  CirculatingBed(const Scene& scene, const CartesianGrid& grid, const std::vector<float>& open)
+      : grid_(grid), open_(open) {
     const ApparatusSpec& a = scene.apparatus;
     halfInlet_ = 0.5 * a.inlet_width;
     slope_ = 1.0 / std::tan(a.prism_angle_deg * M_PI / 180.0);
@@ -80,7 +84,7 @@ class CirculatingBed {
       const std::size_t s = std::size_t(c);
       const double a = alpha_[s];
       const auto cell = std::uint64_t(c), frame = std::uint64_t(n);
-      f.alpha_p[s] = a > 0.0 ? float(std::max(0.0, a + 0.02 * hashNoise(cell, frame))) : 0.0f;
+      f.alpha_p[s] = a > 0.0 ? float(std::max(0.0, a + 0.02 * hashNoise(cell, frame))) : (open_[s] > 0.0f ? kStrayAlpha : 0.0f);
       const double wobble = 1.0 + 0.05 * hashNoise(cell, frame + 7919);
       for (int d = 0; d < 2; ++d) {
         double u = 0.0;
@@ -165,6 +169,7 @@ class CirculatingBed {
   }
 
   CartesianGrid grid_;
+  std::vector<float> open_;  ///< open fraction of each cell
   double halfInlet_ = 0.01, slope_ = 0.577, halfWidth_ = 0.125, bedHeight_ = 0.1;
   std::vector<double> alpha_;
   std::array<std::vector<double>, kModes> up_;  ///< (u_x, u_y) per cell of each mode at unit amplitude [m/s]

@@ -14,6 +14,7 @@ std::shared_ptr<FieldDatabase> sineDb(double dt, double omega, int frames) {
   return makeAnalyticDatabase(g, variedFluid(g, false), dt, frames, [&](int, double t, FieldFrame& f) {
     for (std::int64_t c = 0; c < g.cellCount(); ++c) {
       const double w = omega * double(1 + c % 3);
+      f.alpha_p[std::size_t(c)] = 0.3f;  // particles in every cell: the reader keeps u_P as written
       f.u_p[std::size_t(3 * c + 1)] = float((1.0 + 0.1 * double(c)) * std::sin(w * t));
     }
   });
@@ -54,7 +55,10 @@ TEST(SamplingCriterion, StrictInequalityAtTheResolutionLimit) {
   const CartesianGrid g = smallGrid(2, 2, 2);
   // A velocity component carries the signal: alpha_P must stay a volume fraction in [0, 1].
   auto db = makeAnalyticDatabase(g, variedFluid(g, false), 0.5, 42, [&](int n, double, FieldFrame& f) {
-    for (std::int64_t c = 0; c < g.cellCount(); ++c) f.u_p[3 * std::size_t(c)] = float(gamma[std::size_t(n)]);
+    for (std::int64_t c = 0; c < g.cellCount(); ++c) {
+      f.alpha_p[std::size_t(c)] = 0.3f;  // particles in every cell: the reader keeps u_P as written
+      f.u_p[3 * std::size_t(c)] = float(gamma[std::size_t(n)]);
+    }
   });
   const SamplingReport r = samplingCriterion(*db, "u_p.x");
   EXPECT_DOUBLE_EQ(r.largestAdmissibleDtRec, 0.5);

@@ -1,5 +1,6 @@
 // The step fields (tracers/StepField.hpp): a field built ahead, beside the previous step's motion, is
 // taken only for the frames it was built from, and then equals the field built on demand bit for bit.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -20,6 +21,7 @@ struct ThreeFrames {
   ThreeFrames() {
     // Every cell, component and frame its own value (a swapped frame or blend would show).
     db = database(scene, 3, 0.005, [](int n, double, FieldFrame& f) {
+      std::fill(f.alpha_p.begin(), f.alpha_p.end(), 0.3f);  // particles everywhere: u_P as given
       for (std::size_t i = 0; i < f.u_p.size(); ++i) {
         f.u_p[i] = float(0.01 * double(i) + n);
         f.u_g[i] = float(-0.02 * double(i) + 3.0 * n);
