@@ -65,4 +65,25 @@ BaffleFaces thinWallBaffles(const Apparatus& apparatus, const CartesianGrid& gri
   return out;
 }
 
+bool plateSeparates(const Apparatus& apparatus, const CartesianGrid& grid, const BaffleFaces& baffles,
+                    const std::array<int, 3>& ijk, int d, int side) {
+  if (d > 1) return false;
+  auto face = ijk;
+  face[std::size_t(d)] += side > 0 ? 1 : 0;  // faces carry the index of the cell above them
+  if (baffles.closes(d, face[0], face[1], face[2])) return true;
+  // A plate closes the face when the face's plane lies within its thickness and the plate covers the
+  // face's whole extent across (a face the plate only cuts stays open, as a partly covered baffle).
+  const int across = 1 - d;
+  const double plane = grid.origin[d] + face[std::size_t(d)] * grid.spacing[d];
+  const double from = grid.origin[across] + ijk[std::size_t(across)] * grid.spacing[across];
+  const double to = from + grid.spacing[across];
+  const double slack = kSnap * grid.spacing[across];
+  for (const auto& hole : apparatus.holes()) {
+    Eigen::Vector2d lo = hole[0], hi = hole[0];
+    for (const auto& v : hole) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    if (plane >= lo[d] && plane <= hi[d] && from >= lo[across] - slack && to <= hi[across] + slack) return true;
+  }
+  return false;
+}
+
 }  // namespace rcfd

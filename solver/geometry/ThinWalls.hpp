@@ -44,4 +44,12 @@ struct BaffleFaces {
 /// faces are axis-aligned).
 BaffleFaces thinWallBaffles(const Apparatus& apparatus, const CartesianGrid& grid);
 
+/// Whether a plate separates cell `ijk` from its neighbour along axis d (0: x, 1: y; -1 or +1 for
+/// `side`) as the CFD-DEM's mapping, smoothing and gas see it: a plate that contains the face between
+/// them (the face's plane within its thickness, the face's whole extent across) or a plate snapped to that face
+/// (`baffles`, thinWallBaffles of the same grid). The other face of a cell column holding a plate
+/// stays open. Faces normal to z never are (the plates span the depth).
+bool plateSeparates(const Apparatus& apparatus, const CartesianGrid& grid, const BaffleFaces& baffles,
+                    const std::array<int, 3>& ijk, int d, int side);
+
 }  // namespace rcfd

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "GeometryFixtures.hpp"
 #include "geometry/ThinWalls.hpp"
 
@@ -43,6 +45,30 @@ TEST(ThinWalls, PlateInsideACellColumnClosesItsNearestFace) {
   // The plates are 12 cells tall: the grid's y-faces inside them are cut by FaceApertures already.
   EXPECT_TRUE(b.covered[1].empty());
   EXPECT_FALSE(b.closes(1, 30, 10, 0));
+}
+
+TEST(ThinWalls, APlateSeparatesTheCellsOnItsTwoSidesAndNoneBesideIt) {
+  // 5 mm cells: the right plate lies in column i = 29 (x 0.020-0.025), snapped to the face x = 0.025.
+  const Apparatus app(slice(true));
+  const CartesianGrid g = sliceGrid(app, 0.005);
+  const BaffleFaces b = thinWallBaffles(app, g);
+  const std::array<int, 3> column{29, 10, 1}, annulus{30, 10, 1}, tube{28, 10, 1};
+  EXPECT_TRUE(plateSeparates(app, g, b, column, 0, +1));  // across the baffle
+  EXPECT_TRUE(plateSeparates(app, g, b, annulus, 0, -1));
+  EXPECT_FALSE(plateSeparates(app, g, b, column, 0, -1));  // the column's other face: open
+  EXPECT_FALSE(plateSeparates(app, g, b, tube, 0, +1));
+  EXPECT_FALSE(plateSeparates(app, g, b, column, 1, +1));  // along the plate
+  EXPECT_FALSE(plateSeparates(app, g, b, std::array<int, 3>{29, 30, 1}, 0, +1));  // above its top
+  EXPECT_FALSE(plateSeparates(app, g, b, column, 2, +1));
+  // On 1 mm cells the plate (x 0.0225-0.0245) contains the faces x = 0.023 and 0.024 and has no
+  // baffle: those faces separate, the ones at its surfaces (0.0225 lies inside a cell) do not.
+  const CartesianGrid fine = sliceGrid(app, 0.001);
+  const BaffleFaces none = thinWallBaffles(app, fine);
+  const int i = int(std::lround((0.023 - fine.origin.x()) / fine.spacing.x()));  // face index of x = 0.023
+  EXPECT_TRUE(plateSeparates(app, fine, none, std::array<int, 3>{i - 1, 60, 1}, 0, +1));
+  EXPECT_TRUE(plateSeparates(app, fine, none, std::array<int, 3>{i, 60, 1}, 0, +1));
+  EXPECT_FALSE(plateSeparates(app, fine, none, std::array<int, 3>{i + 2, 60, 1}, 0, +1));
+  EXPECT_FALSE(plateSeparates(app, fine, none, std::array<int, 3>{i - 3, 60, 1}, 0, +1));
 }
 
 TEST(ThinWalls, AFaceIndexPastTheDomainsEdgeIsNoBaffle) {

@@ -22,6 +22,7 @@
 #include <cmath>
 #include <memory>
 
+#include "geometry/ThinWalls.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
@@ -41,6 +42,7 @@ class DirectedRelaxationEffect final : public TracerEffect {
       for (auto& v : ctx.streamVelocity) v.assign(n, 0.0f);
     }
     if (!(d0_ > 0.0)) return;
+    baffles_ = thinWallBaffles(ctx.apparatus, ctx.grid);
     const CartesianGrid& grid = ctx.grid;
     const std::int64_t cells = grid.cellCount();
     row_.assign(std::size_t(cells), -1);
@@ -128,7 +130,9 @@ class DirectedRelaxationEffect final : public TracerEffect {
 
  private:
   /// Calls f(dimension, side, neighbour) for each open neighbour of cell c that no plate separates
-  /// from it (no flux pushes tracers against a plate they cannot pass).
+  /// from it (no flux pushes tracers against a plate they cannot pass): those the CFD-DEM's mapping
+  /// and smoothing keep apart (plateSeparates), so the relaxation moves the particle volume of a cell
+  /// column holding a plate on the side the frames put it.
   template <class F>
   void forEachNeighbour(const TracerContext& ctx, std::int32_t c, F&& f) const {
     const CartesianGrid& grid = ctx.grid;
@@ -140,27 +144,10 @@ class DirectedRelaxationEffect final : public TracerEffect {
         if (nb[std::size_t(d)] < 0 || nb[std::size_t(d)] >= grid.shape[std::size_t(d)]) continue;
         const auto other = std::int32_t(grid.flatIndex(nb[0], nb[1], nb[2]));
         if (row_[std::size_t(other)] < 0) continue;
-        if (d < 2 && plateBetween(ctx.apparatus, grid.cellCenter(ijk[0], ijk[1], ijk[2]),
-                                  grid.cellCenter(nb[0], nb[1], nb[2]), d)) {
-          continue;
-        }
+        if (plateSeparates(ctx.apparatus, grid, baffles_, ijk, d, side)) continue;
         f(d, side, other);
       }
     }
-  }
-
-  /// Whether the segment a-b along axis d (0: x, 1: y) of the section crosses a plate (the plates are
-  /// axis-aligned rectangles extruded along z, so faces normal to z never do).
-  static bool plateBetween(const Apparatus& apparatus, const Eigen::Vector3d& a, const Eigen::Vector3d& b, int d) {
-    const int across = 1 - d;
-    for (const auto& plate : apparatus.holes()) {
-      Eigen::Vector2d lo = plate[0], hi = plate[0];
-      for (const auto& v : plate) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-      const double at = a[across];
-      if (!(at > lo[across] && at < hi[across])) continue;
-      if (std::max(a[d], b[d]) > lo[d] && std::min(a[d], b[d]) < hi[d]) return true;
-    }
-    return false;
   }
 
   /// e = alpha_P of the tracers - alpha_P^rec of the step, then one implicit diffusion step of it.
@@ -213,6 +200,7 @@ class DirectedRelaxationEffect final : public TracerEffect {
   double d0_, cap_;
   bool owner_ = false;
   std::size_t tracers_ = 0;
+  BaffleFaces baffles_;              ///< the plates snapped to grid faces (geometry/ThinWalls.hpp)
   std::vector<std::int32_t> row_;   ///< per cell: its row among the open cells, or -1
   std::vector<std::int32_t> open_;  ///< per row: its cell
   std::vector<std::int32_t> upperNeighbour_;  ///< per row and axis: the row of the open cell above, or -1
