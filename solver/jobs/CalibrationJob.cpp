@@ -305,6 +305,7 @@ class CalibrationJob final : public JobRunner {
     summary["dt"] = scene.rcfd.dt;
     summary["tracers"] = scene.rcfd.tracers;
     summary["effects"] = calibrationEffects(scene);
+    summary["frame_spacing"] = toJson(rec.frameSpacing);
     summary["path"] = {{"jumps", rec.pathStats.jumps},
                        {"mean_jump_similarity", rec.pathStats.meanJumpSimilarity},
                        {"mean_sequence_frames", rec.pathStats.meanSequenceLength}};

@@ -103,6 +103,8 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
     storage.progress = [&](double f) { report(readOnce, readOnce + work.matrix, f); };
     if (!setup.database) setup.database = FieldDatabase::open(databasePath, storage);
   }
+  setup.frameSpacing = frameSpacing(*setup.database, SprayZone(scene.spray.spray_zone));
+  if (const std::string warning = sparseFramesWarning(setup.frameSpacing); !warning.empty()) spdlog::warn("{}", warning);
   if (!PathGeneratorRegistry::contains(scene.rcfd.path.type)) {
     throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));
   }

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 
+#include "analysis/FrameSpacing.hpp"
 #include "fields/FieldDatabase.hpp"
 #include "recurrence/RecurrenceMatrix.hpp"
 #include "recurrence/RecurrencePath.hpp"
@@ -21,6 +22,7 @@ struct RecurrenceSetup {
   RecurrencePath path;
   PathStatistics pathStats;
   bool matrixWasStored = false;  ///< read from /recurrence/matrix instead of computed
+  FrameSpacing frameSpacing;     ///< how far the spray zone's particles move between two frames
 };
 
 /// What prepareRecurrence() has to do for a database and its expected work, in tracer steps (one

@@ -94,7 +94,7 @@ nlohmann::json coverageComparison(const JobSpec& job, const Scene& scene, const 
 /// rates); figures into `figureDir` (none when empty). `poll` is called between the parts.
 nlohmann::json writeRunResults(const JobSpec& job, const TracerSimulation& sim, std::uint64_t seed,
                                std::int64_t steps, const RecurrencePath& path, const PathStatistics& pathStats,
-                               const std::string& dir, const std::string& figureDir,
+                               const FrameSpacing& spacing, const std::string& dir, const std::string& figureDir,
                                const std::function<void()>& poll) {
   const Scene& scene = job.scene;
   nlohmann::json summary = {{"kind", job.kind},
@@ -120,6 +120,7 @@ nlohmann::json writeRunResults(const JobSpec& job, const TracerSimulation& sim, 
       coverageComparison(job, scene, dir + "/result.h5", sim.cloud().particlesPerTracer, sim.time());
   poll();
   if (scene.outputs.svg && !figureDir.empty()) summary["figures"] = sim.writeFigures(figureDir);
+  summary["frame_spacing"] = toJson(spacing);
   summary["path"] = {{"jumps", pathStats.jumps},
                      {"mean_jump_similarity", pathStats.meanJumpSimilarity},
                      {"mean_sequence_frames", pathStats.meanSequenceLength}};
@@ -219,8 +220,8 @@ class TracerJob final : public JobRunner {
     };
 
     const double wall = priorWall + std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-    nlohmann::json summary = writeRunResults(job, sim, job.seed, steps, rec.path, rec.pathStats, options.outDir,
-                                             options.outDir, pollInResults);
+    nlohmann::json summary = writeRunResults(job, sim, job.seed, steps, rec.path, rec.pathStats, rec.frameSpacing,
+                                             options.outDir, options.outDir, pollInResults);
     // Wall time and rates describe this machine, not the physics: the only keys allowed to differ
     // between otherwise bit-identical runs.
     summary["wall_time_s"] = wall;
@@ -346,7 +347,7 @@ class TracerJob final : public JobRunner {
         }
       };
       nlohmann::json summary =
-          writeRunResults(job, sim, seed, steps, path, pathStats, dir, k == 0 ? options.outDir : std::string(), poll);
+          writeRunResults(job, sim, seed, steps, path, pathStats, rec.frameSpacing, dir, k == 0 ? options.outDir : std::string(), poll);
       writeFileAtomically(dir + "/summary.json", summary.dump(2) + "\n");
       fs::remove(checkpoint);
     };
