@@ -8,7 +8,7 @@
 namespace rcfd::server {
 
 namespace {
-constexpr const char* kVersion = "0.1.0";
+constexpr const char* kVersion = RCFD_VERSION;
 
 StringResponse methodNotAllowed(const Target& target, const std::string& allow) {
   auto res = problem(http::status::method_not_allowed, "method-not-allowed", "Method not allowed",

@@ -381,6 +381,7 @@ CREATE TABLE databases (id TEXT PRIMARY KEY, path TEXT NOT NULL, bytes INTEGER N
     ServerProcess server(data, "single-token");
     const auto health = server.get("/v1/health").json();
     EXPECT_EQ(health.at("schema_version"), 4);  // users (3), then the running job's phase (4)
+    EXPECT_EQ(health.at("version"), RCFD_VERSION);  // the project's, from CMakeLists.txt
     const auto job = server.get("/v1/jobs/" + oldJob);
     ASSERT_EQ(job.status, 200) << job.body;
     EXPECT_EQ(job.json().at("owner"), "admin");
