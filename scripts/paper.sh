@@ -8,8 +8,9 @@
 # Resumable: run it again with the same OUT_DIR; finished jobs are kept, interrupted ones resume from
 # their checkpoints. A database job takes hours on 2 cores (docs/performance.md), so put OUT_DIR outside
 # the repository. RCFD_PAPER_SPRAY_S sets the spray duration (default 3600 s), RCFD_PAPER_STAGES the
-# stages to run (default "database calibration spray"). Progress goes to the terminal and to each
-# job's log in OUT_DIR. Needs a build and jq.
+# stages to run (default "database calibration spray"), RCFD_SOLVE the rcfd-solve to run (default
+# build/rcfd-solve; a copy lets a rebuild go on beside a long job). Progress goes to the terminal and to
+# each job's log in OUT_DIR. Needs a build and jq.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 1 ]; then
@@ -22,7 +23,7 @@ variants=("$@")
 [ ${#variants[@]} -gt 0 ] || variants=(procell-coarse-grained procell-coarse-grained-draft-plates)
 spray_s=${RCFD_PAPER_SPRAY_S:-3600}
 stages=${RCFD_PAPER_STAGES:-database calibration spray}
-solve=$(pwd)/build/rcfd-solve
+solve=${RCFD_SOLVE:-$(pwd)/build/rcfd-solve}
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 [ -x "$solve" ] || { echo "$0: no build; run scripts/build.sh" >&2; exit 2; }
 

@@ -73,6 +73,9 @@ inline void locateBlock(const TrilinearLocator::Constants& q, int count, const d
     s.fz[k] = float(TrilinearLocator::Constants::axis(z[k], oz, iz, lastZ, maxZ, lz));
     s.base[k] = lx + ly * sy + lz * sz;
   }
+  if (q.plates) {
+    for (int k = 0; k < count; ++k) keepStencilOnPlateSide(q.plates, s.base[k], sy, sz, s.fx[k], s.fy[k], s.fz[k]);
+  }
 }
 
 /// The grid coordinates g = (x - origin) / spacing of a point along one axis, in float: the motion
@@ -99,17 +102,21 @@ struct GridConstants {
   float lastX = 0, lastY = 0, lastZ = 0;
   int maxX = 0, maxY = 0, maxZ = 0;
   std::int32_t sy = 0, sz = 0;
+  const std::uint8_t* plates = nullptr;  ///< plate faces (null: none)
   explicit GridConstants(const TrilinearLocator::Constants& q = {})
       : ox(q.ox), oy(q.oy), oz(q.oz), ix(q.ix), iy(q.iy), iz(q.iz), fix(float(q.ix)), fiy(float(q.iy)),
         fiz(float(q.iz)), lastX(float(q.lastX)), lastY(float(q.lastY)), lastZ(float(q.lastZ)), maxX(q.maxX),
-        maxY(q.maxY), maxZ(q.maxZ), sy(q.sy), sz(q.sz) {}
-  /// Base index and fractions of the point with grid coordinates (gx, gy, gz).
+        maxY(q.maxY), maxZ(q.maxZ), sy(q.sy), sz(q.sz), plates(q.plates) {}
+  /// Base index and fractions of the point with grid coordinates (gx, gy, gz), kept on its side of the
+  /// plates (locateGridBlock()'s arithmetic).
   std::int32_t locate(float gx, float gy, float gz, float& fx, float& fy, float& fz) const {
     int lx, ly, lz;
     fx = gridAxis(gx, lastX, maxX, lx);
     fy = gridAxis(gy, lastY, maxY, ly);
     fz = gridAxis(gz, lastZ, maxZ, lz);
-    return lx + ly * sy + lz * sz;
+    const std::int32_t base = lx + ly * sy + lz * sz;
+    if (plates) keepStencilOnPlateSide(plates, base, sy, sz, fx, fy, fz);
+    return base;
   }
 };
 
@@ -136,6 +143,9 @@ inline void locateGridBlock(const GridConstants& q, int count, const float* gx, 
     s.fy[k] = gridAxis(gy[k], lastY, maxY, ly);
     s.fz[k] = gridAxis(gz[k], lastZ, maxZ, lz);
     s.base[k] = lx + ly * sy + lz * sz;
+  }
+  if (q.plates) {
+    for (int k = 0; k < count; ++k) keepStencilOnPlateSide(q.plates, s.base[k], sy, sz, s.fx[k], s.fy[k], s.fz[k]);
   }
 }
 

@@ -17,9 +17,10 @@ namespace rcfd {
 
 class FrameSampler {
  public:
+  /// plates: per cell the plate faces interpolation does not cross (TrilinearLocator), or null.
   FrameSampler(const CartesianGrid& grid, const FieldFrame* frame, const FieldFrame* next = nullptr,
-               double blend = 0.0)
-      : locator_(grid), a_(frame), b_(next && blend > 0.0 ? next : nullptr), w_(blend) {}
+               double blend = 0.0, const std::uint8_t* plates = nullptr)
+      : locator_(grid, plates), a_(frame), b_(next && blend > 0.0 ? next : nullptr), w_(blend) {}
 
   const FieldFrame& frame() const { return *a_; }
   const FieldFrame* nextFrame() const { return b_; }

@@ -39,6 +39,11 @@ struct TracerContext {
   std::uint64_t seed = 1;
 
   std::vector<double> openVolume;  ///< open volume of each cell [m3]
+  /// Per cell, the plate faces interpolation does not cross (plateFacesAbove,
+  /// geometry/ThinWalls.hpp); empty without
+  /// plates thinner than a cell, or where the context's points may lie between a plate and its face.
+  std::vector<std::uint8_t> plateFaces;
+  const std::uint8_t* plateFacesOrNull() const { return plateFaces.empty() ? nullptr : plateFaces.data(); }
   double dt = 0.0;                 ///< tracer time step [s]
   std::int64_t step = 0;           ///< index of the step being taken (time = step * dt)
   std::int64_t discardSteps = 0;   ///< statistics ignore steps before this one (calibration)
@@ -48,7 +53,7 @@ struct TracerContext {
   std::shared_ptr<const FieldFrame> frame;      ///< frame of this step
   std::shared_ptr<const FieldFrame> nextFrame;  ///< next frame of the same sequence, when blending
   double blend = 0.0;                           ///< weight of nextFrame in [0, 1)
-  FrameSampler sampler() const { return FrameSampler(grid, frame.get(), nextFrame.get(), blend); }
+  FrameSampler sampler() const { return FrameSampler(grid, frame.get(), nextFrame.get(), blend, plateFacesOrNull()); }
   /// u_P^rec or u_G^rec of this step as a step field (built on first use in the step).
   const StepVelocityField& stepVelocity(bool useGas, StepFieldLayout layout = StepFieldLayout::Padded) {
     return stepFields.velocity(sampler(), useGas, grid.cellCount() > kParallelThreshold, layout);

@@ -9,6 +9,7 @@
 
 #include "core/Errors.hpp"
 #include "core/Permutation.hpp"
+#include "geometry/ThinWalls.hpp"
 #include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FrameInterpolation.hpp"
@@ -44,7 +45,11 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   }
   const auto effects = TracerEffectRegistry::resolve(scene_.effects);
 
-  apparatus_ = std::make_unique<Apparatus>(scene_.apparatus);
+  // The tracers live on the database's grid: a plate thinner than a cell is where the frames put it,
+  // widened to its baffle face (geometry/ThinWalls.hpp), so no tracer enters the strip the frames
+  // count on the plate's other side.
+  const Apparatus exact(scene_.apparatus);
+  apparatus_ = std::make_unique<Apparatus>(exact.withPlates(platesOnGrid(exact, database_->grid())));
   cloud_.resize(std::size_t(scene_.rcfd.tracers));
   const auto& p = scene_.particles;
   cloud_.particleVolume = std::numbers::pi / 6.0 * p.diameter * p.diameter * p.diameter;
@@ -60,6 +65,7 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   const auto& fluid = database_->fluidFraction();
   ctx.openVolume.resize(fluid.size());
   for (std::size_t c = 0; c < fluid.size(); ++c) ctx.openVolume[c] = fluid[c] * ctx.grid.cellVolume();
+  ctx.plateFaces = plateFacesAbove(*apparatus_, ctx.grid);
 
   loadFrames();
   placeTracers();

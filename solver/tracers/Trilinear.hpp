@@ -5,14 +5,32 @@
 /// are the base plus fixed offsets, so a stencil needs one index computation (the motion kernel's
 /// float combination of the corners is block::interpolateCorners).
 /// Beyond the outermost centres values are extrapolated as constants (the fractions are clamped).
+/// Across a plate thinner than a cell (a baffle face, geometry/ThinWalls.hpp) no value is taken from
+/// the other side: given the grid's plate faces, a stencil whose two centres along x or y a plate
+/// separates takes its own side's centre (keepStencilOnPlateSide).
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
 
 #include "geometry/CartesianGrid.hpp"
+#include "geometry/ThinWalls.hpp"
 
 namespace rcfd {
+
+/// The stencil (base, fractions) of a point kept on its side of the plates: along x (or y), when a
+/// plate closes the face between the stencil's two centres in the point's own row (layer), the fraction
+/// becomes that of the point's own centre, 0 or 1: the value up to the plate is its own side's, held
+/// constant, as beyond the outermost centres. The point's side is that of its cell (fraction >= 1/2),
+/// exact for points outside the strips between a plate and its face (the tracers: their walls are
+/// platesOnGrid).
+template <class T>
+inline void keepStencilOnPlateSide(const std::uint8_t* plates, std::int32_t base, std::int32_t sy, std::int32_t sz,
+                                   T& fx, T& fy, T fz) {
+  const std::int32_t ox = fx >= T(0.5), oy = fy >= T(0.5), oz = fz >= T(0.5);
+  if (plates[base + oy * sy + oz * sz] & kPlateAboveX) fx = T(ox);
+  if (plates[base + ox + oz * sz] & kPlateAboveY) fy = T(oy);
+}
 
 /// A point's place among the cell centres: flat index of the low corner of the 2x2x2 block of centres
 /// around it and the fractions along x, y, z within that block, each in [0, 1].
@@ -24,7 +42,9 @@ struct TrilinearStencil {
 /// The grid in the form the hot loop needs: inverse spacing, clamping bounds and corner offsets.
 class TrilinearLocator {
  public:
-  explicit TrilinearLocator(const CartesianGrid& grid) {
+  /// plates: per cell the plate faces (plateFacesAbove, geometry/ThinWalls.hpp), or null for none; kept
+  /// by the caller.
+  explicit TrilinearLocator(const CartesianGrid& grid, const std::uint8_t* plates = nullptr) : plates_(plates) {
     std::int64_t stride = 1;
     std::int64_t step[3];
     for (int d = 0; d < 3; ++d) {
@@ -46,17 +66,19 @@ class TrilinearLocator {
   TrilinearStencil locate(const Eigen::Vector3d& p) const {
     TrilinearStencil s;
     std::int32_t base = 0;
-    locate(p.x(), p.y(), p.z(), base, s.f[0], s.f[1], s.f[2]);
+    locate(p.x(), p.y(), p.z(), base, s.f[0], s.f[1], s.f[2]);  // kept on its side of the plates
     s.base = base;
     return s;
   }
 
   /// The locator's numbers as a plain value, for loops over many points that the compiler vectorises
-  /// (`#pragma omp simd`): Constants::locate is the arithmetic of locate(), hence gives the same result.
+  /// (`#pragma omp simd`): Constants::locate is the arithmetic of locate() without the plates, which
+  /// such loops apply after it (keepOnPlateSide), so both give the same result.
   struct Constants {
     double ox, oy, oz, ix, iy, iz, lastX, lastY, lastZ;
     int maxX, maxY, maxZ;
     std::int32_t sy, sz;
+    const std::uint8_t* plates = nullptr;  ///< the locator's plate faces (null: none)
     static double axis(double x, double o, double inv, double last, int maxLow, int& lo) {
       double t = (x - o) * inv - 0.5;
       t = t > 0.0 ? t : 0.0;  // not std::clamp: the branch-free form vectorises
@@ -73,14 +95,20 @@ class TrilinearLocator {
       fz = axis(z, oz, iz, lastZ, maxZ, lz);
       return lx + ly * sy + lz * sz;
     }
+    /// locate()'s stencil kept on its side of the plates (a no-op without plates).
+    void keepOnPlateSide(std::int32_t base, double& fx, double& fy, double fz) const {
+      if (plates) keepStencilOnPlateSide(plates, base, sy, sz, fx, fy, fz);
+    }
   };
   Constants constants() const {
-    return {origin_[0], origin_[1], origin_[2], inv_[0],    inv_[1],    inv_[2],     last_[0],
-            last_[1],   last_[2],   maxLow_[0], maxLow_[1], maxLow_[2], stride32_[1], stride32_[2]};
+    return {origin_[0], origin_[1], origin_[2], inv_[0],    inv_[1],      inv_[2],      last_[0], last_[1],
+            last_[2],   maxLow_[0], maxLow_[1], maxLow_[2], stride32_[1], stride32_[2], plates_};
   }
 
   void locate(double x, double y, double z, std::int32_t& base, double& fx, double& fy, double& fz) const {
-    base = constants().locate(x, y, z, fx, fy, fz);
+    const Constants q = constants();
+    base = q.locate(x, y, z, fx, fy, fz);
+    q.keepOnPlateSide(base, fx, fy, fz);
   }
 
   /// Offset (in cells) of corner c from the base; bit 0 of c is x, bit 1 y, bit 2 z.
@@ -89,6 +117,7 @@ class TrilinearLocator {
 
  private:
 
+  const std::uint8_t* plates_ = nullptr;
   double origin_[3], inv_[3], last_[3];
   int maxLow_[3];
   std::int32_t stride32_[3];  // tracer cells are int32 throughout (TracerContext::tracerCell)

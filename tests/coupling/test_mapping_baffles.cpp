@@ -103,6 +103,26 @@ TEST(MappingBaffles, ParcelOutsideAPlateKeepsItsVolumeOnItsSide) {
   EXPECT_EQ(m.mapping.weights(above).count, m.transparent.weights(above).count);
 }
 
+TEST(MappingBaffles, ParcelBetweenAPlateAndItsBaffleFaceMapsToThePlatesSideItIsOn) {
+  // Column 29 (x 0.020-0.025) holds the right plate (0.0225-0.0245), snapped to x = 0.025: a parcel
+  // centre in the strip 0.0245-0.025 is on the annulus's side of the plate though its cell is on the
+  // tube's side of the baffle (on the quick example's 6.6 mm cells the annulus's parcels resting
+  // against the plate have their centres there). Its volume goes to the annulus's cells, none to the tube's.
+  PlateMapping m;
+  const Eigen::Vector3d strip(0.0248, 0.065, 0.01);
+  ASSERT_EQ(m.grid.cellOf(strip)[0], kRightCol - 1);
+  const KernelWeights w = m.mapping.weights(strip);
+  double sum = 0.0;
+  for (int q = 0; q < w.count; ++q) {
+    EXPECT_GE(m.grid.cellIjk(w.cell[std::size_t(q)])[0], kRightCol);
+    sum += w.w[std::size_t(q)];
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-15);
+  // On the tube's side of the plate, the same distance from it, the volume stays in the tube.
+  const KernelWeights tube = m.mapping.weights(Eigen::Vector3d(0.0222, 0.065, 0.01));
+  for (int q = 0; q < tube.count; ++q) EXPECT_LT(m.grid.cellIjk(tube.cell[std::size_t(q)])[0], kRightCol);
+}
+
 TEST(MappingBaffles, ExcessVolumeDoesNotCrossAPlate) {
   PlateMapping m;
   std::vector<double> volume(std::size_t(m.grid.cellCount()), 0.0);

@@ -111,6 +111,58 @@ TEST(ThinWalls, PlateInTheLowerHalfOfItsColumnClosesTheLowerFace) {
   EXPECT_TRUE(b.closes(0, 21, 10, 0));   // the left plate mirrors it onto x = -0.020
 }
 
+TEST(ThinWalls, APointBetweenAPlateAndItsBaffleFaceBelongsToTheCellAcrossTheFace) {
+  // 5 mm cells: the right plate (x 0.0225-0.0245) is snapped to x = 0.025, leaving the strip
+  // 0.0245-0.025 of column 29 beyond the plate: the annulus's side. The left plate mirrors it.
+  const Apparatus app(slice(true));
+  const CartesianGrid g = sliceGrid(app, 0.005);
+  const BaffleFaces b = thinWallBaffles(app, g);
+  ASSERT_EQ(b.strips.size(), 2u);
+  using V = Eigen::Vector3d;
+  EXPECT_EQ(b.homeCell(g, V(0.0248, 0.06, 0.01)), (std::array<int, 3>{30, 12, 2}));   // strip: annulus
+  EXPECT_EQ(b.homeCell(g, V(0.0215, 0.06, 0.01)), (std::array<int, 3>{29, 12, 2}));   // tube side: own
+  EXPECT_EQ(b.homeCell(g, V(-0.0248, 0.06, 0.01)), (std::array<int, 3>{19, 12, 2}));  // left strip
+  EXPECT_EQ(b.homeCell(g, V(0.0248, 0.0975, 0.01)), (std::array<int, 3>{29, 19, 2}));  // above the plate
+  // The grid's plates reach the baffle faces; the plate's other face stays where it is.
+  const auto onGrid = platesOnGrid(app, g);
+  ASSERT_EQ(onGrid.size(), 2u);
+  EXPECT_NEAR(onGrid[1].min().x(), 0.0225, 1e-15);
+  EXPECT_NEAR(onGrid[1].max().x(), 0.025, 1e-15);
+  EXPECT_NEAR(onGrid[0].min().x(), -0.025, 1e-15);
+  EXPECT_NEAR(onGrid[0].max().x(), -0.0225, 1e-15);
+  EXPECT_EQ(onGrid[1].min().y(), 0.035);
+  // The apparatus with those plates: the strip is wall, the tube side open, the section smaller by it.
+  const Apparatus tracers = app.withPlates(onGrid);
+  EXPECT_FALSE(tracers.contains(V(0.0248, 0.06, 0.01)));
+  EXPECT_TRUE(tracers.contains(V(0.0215, 0.06, 0.01)));
+  EXPECT_NEAR(app.sectionArea() - tracers.sectionArea(), 2 * 0.0005 * 0.06, 1e-12);
+  // Its baffles are the same faces, and the per-cell plate faces mark them from the lower cell.
+  const BaffleFaces again = thinWallBaffles(tracers, g);
+  EXPECT_EQ(again.covered[0], b.covered[0]);
+  const auto faces = plateFacesAbove(app, g);
+  EXPECT_EQ(faces[std::size_t(g.flatIndex(29, 12, 2))], kPlateAboveX);
+  EXPECT_EQ(faces[std::size_t(g.flatIndex(30, 12, 2))], 0);
+  EXPECT_EQ(faces[std::size_t(g.flatIndex(19, 12, 2))], kPlateAboveX);  // the face x = -0.025 (index 20)
+  // A plate containing faces closes them itself (1 mm cells): they are plate faces too.
+  const CartesianGrid mm = sliceGrid(app, 0.001);
+  const auto resolved = plateFacesAbove(app, mm);
+  const int face = int(std::lround((0.023 - mm.origin.x()) / mm.spacing.x()));
+  EXPECT_EQ(resolved[std::size_t(mm.flatIndex(face - 1, 60, 1))], kPlateAboveX);
+  EXPECT_EQ(resolved[std::size_t(mm.flatIndex(face + 2, 60, 1))], 0);
+  // Snapped to the lower face (gap 0.042: plate 0.021-0.023, face 0.020), the strip is the tube's.
+  ApparatusSpec lower = slice(true);
+  lower.draft_plates->gap = 0.042;
+  const Apparatus low(lower);
+  const BaffleFaces lb = thinWallBaffles(low, g);
+  EXPECT_EQ(lb.homeCell(g, V(0.0205, 0.06, 0.01)), (std::array<int, 3>{28, 12, 2}));
+  EXPECT_EQ(lb.homeCell(g, V(0.0235, 0.06, 0.01)), (std::array<int, 3>{29, 12, 2}));
+  EXPECT_NEAR(platesOnGrid(low, g)[1].min().x(), 0.020, 1e-15);
+  // Plates the grid resolves keep their shape.
+  const CartesianGrid fine = sliceGrid(app, 0.0005);
+  EXPECT_TRUE(thinWallBaffles(app, fine).strips.empty());
+  EXPECT_NEAR(platesOnGrid(app, fine)[1].max().x(), 0.0245, 1e-15);
+}
+
 TEST(ThinWalls, ResolvedPlatesAndApparatusWithoutPlatesHaveNoBaffles) {
   // 0.5 mm cells: faces lie inside the plates (they are closed by the cut cells and face apertures).
   const Apparatus plates(slice(true));

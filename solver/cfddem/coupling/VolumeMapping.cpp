@@ -35,7 +35,9 @@ KernelWeights VolumeMapping::weights(const Eigen::Vector3d& x) const {
     w1[a] = n == 1 ? 0.0 : t - i0[a];
   }
   const bool cut = !baffles_.empty();
-  const std::array<int, 3> home = cut ? grid_.cellOf(x) : std::array<int, 3>{};
+  // A parcel between a plate and the face the plate is snapped to counts from the cell across that
+  // face: the side of the plate it is on (BaffleFaces::homeCell).
+  const std::array<int, 3> home = cut ? baffles_.homeCell(grid_, x) : std::array<int, 3>{};
   double sum = 0.0;
   for (int c = 0; c < 8; ++c) {
     const int o[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};

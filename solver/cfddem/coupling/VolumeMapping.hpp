@@ -7,7 +7,8 @@
 /// puts volume into a closed cell. The same weights interpolate cell fields to the parcel, so what a
 /// parcel takes from a cell is what the cell gives (momentum exchange, docs/physics.md "Coupling").
 /// Walls thinner than a cell (baffles, geometry/ThinWalls.hpp) cut the kernel: a cell centre that the
-/// parcel's own cell reaches only through a baffle face gets no weight, so no volume crosses a plate.
+/// parcel's own cell reaches only through a baffle face gets no weight, so no volume crosses a plate;
+/// a parcel in the strip between a plate and its baffle face counts from the cell across the face.
 
 #include <Eigen/Core>
 #include <array>

@@ -93,7 +93,7 @@ class LangevinVelocityEffect final : public TracerEffect {
     const std::size_t n = ctx.cloud.size();
     const CounterRngPrefix prefix(ctx.seed, RngPurpose::Langevin, std::uint64_t(ctx.step));
     const std::int32_t* id = ctx.cloud.id.data();
-    const TrilinearLocator::Constants locator = TrilinearLocator(ctx.grid).constants();
+    const TrilinearLocator::Constants locator = TrilinearLocator(ctx.grid, ctx.plateFacesOrNull()).constants();
     const std::int32_t corner[8] = {0, 1, locator.sy, locator.sy + 1, locator.sz, locator.sz + 1,
                                     locator.sz + locator.sy, locator.sz + locator.sy + 1};
     const double* position[3] = {ctx.cloud.x.data(), ctx.cloud.y.data(), ctx.cloud.z.data()};
@@ -107,7 +107,9 @@ class LangevinVelocityEffect final : public TracerEffect {
       // The step's coefficients at the tracer's position, trilinear between cell centres: the drift's
       // gradient within a cell then keeps the tracers' density there as alpha_P^rec varies.
       double f[3];
-      const std::size_t base = std::size_t(locator.locate(position[0][i], position[1][i], position[2][i], f[0], f[1], f[2]));
+      const std::int32_t stencil = locator.locate(position[0][i], position[1][i], position[2][i], f[0], f[1], f[2]);
+      locator.keepOnPlateSide(stencil, f[0], f[1], f[2]);
+      const std::size_t base = std::size_t(stencil);
       double at[kCoefficients] = {};
       for (int k = 0; k < 8; ++k) {
         const double w = ((k & 1) ? f[0] : 1.0 - f[0]) * ((k & 2) ? f[1] : 1.0 - f[1]) * ((k & 4) ? f[2] : 1.0 - f[2]);
