@@ -8,17 +8,17 @@
 #include <mutex>
 
 #include "core/Errors.hpp"
+#include "core/Hdf5.hpp"
 #include "fields/FieldDatabase.hpp"
 #include "fields/FieldValidation.hpp"
 #include "fields/FrameCache.hpp"
 #include "fields/VelocityCompletion.hpp"
-#include "fields/Hdf5.hpp"
 
 namespace rcfd {
 
 namespace {
 
-using hdf5::Handle;
+using h5::Handle;
 
 /// Everything but the frames: read once at open.
 struct Header {
@@ -77,7 +77,7 @@ struct FrameReader {
   void readPart(hid_t set, const char* name, int index, int components, std::vector<float>& out) const {
     const std::int64_t cells = grid.cellCount();
     out.resize(std::size_t(cells * components));
-    Handle space = hdf5::check(H5Dget_space(set), name);
+    Handle space = h5::check(H5Dget_space(set), name);
     std::vector<hsize_t> start(components == 1 ? 4 : 5, 0), count(start.size(), 0);
     start[0] = hsize_t(index);
     count[0] = 1;
@@ -85,12 +85,12 @@ struct FrameReader {
     count[2] = hsize_t(grid.shape[1]);
     count[3] = hsize_t(grid.shape[0]);
     if (components == 3) count[4] = 3;
-    hdf5::checkStatus(H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                                          nullptr),
-                      path + ": selecting frame " + std::to_string(index) + " of " + name);
+    h5::checkStatus(H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                                        nullptr),
+                    path + ": selecting frame " + std::to_string(index) + " of " + name);
     // The memory space has the selection's shape: with a flat one HDF5 maps element by element
     // between the two shapes (H5S_select_iterate), about 50x slower than a matching shape.
-    Handle memory = hdf5::check(H5Screate_simple(int(count.size()), count.data(), nullptr), name);
+    Handle memory = h5::check(H5Screate_simple(int(count.size()), count.data(), nullptr), name);
     // H5T_NATIVE_FLOAT as memory type: HDF5 converts float64 (or other float) datasets on read.
     if (H5Dread(set, H5T_NATIVE_FLOAT, memory, space, H5P_DEFAULT, out.data()) < 0) {
       throw RunError(path + ": reading frame " + std::to_string(index) + " of " + name + " failed");
@@ -156,7 +156,7 @@ std::string dimsText(const std::vector<hsize_t>& dims) {
 /// returns its first dimension through `first` (rank = 1 + trailing.size()).
 Handle openFloatDataset(hid_t file, const char* name, const std::vector<hsize_t>& trailing,
                         std::vector<Violation>& violations, hsize_t* first) {
-  if (!hdf5::linkExists(file, name)) {
+  if (!h5::linkExists(file, name)) {
     violations.push_back({name, "dataset is missing"});
     return {};
   }
@@ -165,11 +165,11 @@ Handle openFloatDataset(hid_t file, const char* name, const std::vector<hsize_t>
     violations.push_back({name, "is not a dataset"});
     return {};
   }
-  if (hdf5::datasetClass(set) != H5T_FLOAT) {
+  if (h5::datasetClass(set) != H5T_FLOAT) {
     violations.push_back({name, "must hold floating-point values (float32; float64 is converted)"});
     return {};
   }
-  const auto dims = hdf5::datasetDims(set);
+  const auto dims = h5::datasetDims(set);
   const std::size_t rank = trailing.size() + (first ? 1 : 0);
   std::vector<hsize_t> tail(dims.end() - std::min(dims.size(), trailing.size()), dims.end());
   if (dims.size() != rank || tail != trailing) {
@@ -188,31 +188,31 @@ Header readHeader(hid_t file, const std::string& path) {
   h.path = path;
   std::vector<Violation> v;
   // Root attributes.
-  const auto format = hdf5::readStringAttribute(file, "format");
+  const auto format = h5::readStringAttribute(file, "format");
   if (!format) v.push_back({"/@format", "string attribute is missing; expected \"rcfd-field-database\""});
   else if (*format != layout::formatName)
     v.push_back({"/@format", "is \"" + *format + "\"; expected \"rcfd-field-database\""});
-  const auto version = hdf5::readNumericAttribute(file, "version");
+  const auto version = h5::readNumericAttribute(file, "version");
   if (!version || version->size() != 1) v.push_back({"/@version", "integer attribute is missing; expected 1"});
   else if ((*version)[0] != layout::version)
     v.push_back({"/@version", "is " + std::to_string((*version)[0]) + "; this reader knows version 1"});
-  const auto dt = hdf5::readNumericAttribute(file, "dt_rec");
+  const auto dt = h5::readNumericAttribute(file, "dt_rec");
   if (!dt || dt->size() != 1) v.push_back({"/@dt_rec", "numeric attribute is missing (sampling interval [s])"});
   else {
     h.dtRec = (*dt)[0];
     validateDtRec(h.dtRec, v);
   }
   // Scene.
-  if (!hdf5::linkExists(file, layout::scene)) {
+  if (!h5::linkExists(file, layout::scene)) {
     v.push_back({layout::scene, "dataset is missing (a string holding the scene JSON)"});
   } else {
     Handle set(H5Dopen2(file, layout::scene, H5P_DEFAULT));
-    auto text = set.valid() ? hdf5::readStringDataset(set) : std::nullopt;
+    auto text = set.valid() ? h5::readStringDataset(set) : std::nullopt;
     if (!text) v.push_back({layout::scene, "must be a scalar string dataset (the scene JSON)"});
     else h.scene = *text;
   }
   // Grid.
-  if (!hdf5::linkExists(file, layout::grid)) {
+  if (!h5::linkExists(file, layout::grid)) {
     v.push_back({layout::grid, "group is missing"});
     refuse(path, std::move(v));
   }
@@ -220,7 +220,7 @@ Header readHeader(hid_t file, const std::string& path) {
   const char* names[3] = {"origin", "spacing", "shape"};
   std::vector<double> values[3];
   for (int a = 0; a < 3; ++a) {
-    auto x = hdf5::readNumericAttribute(grid, names[a]);
+    auto x = h5::readNumericAttribute(grid, names[a]);
     if (!x) {
       v.push_back({std::string("/grid@") + names[a], "numeric attribute with 3 values (x, y, z) is missing"});
     } else if (x->size() != 3) {
@@ -264,7 +264,7 @@ Header readHeader(hid_t file, const std::string& path) {
 }  // namespace
 
 std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, FrameStorage storage) {
-  hdf5::silenceErrors();
+  h5::silenceErrors();
   if (storage.cacheBytes < 0) {
     throw InputError(path, "/rcfd/frame_cache_bytes",
                      std::to_string(storage.cacheBytes) + " is negative; 0 (all in RAM) or a size in bytes");
@@ -272,7 +272,7 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   if (!std::filesystem::exists(path)) throw InputError(path, "", "file does not exist");
   if (H5Fis_hdf5(path.c_str()) <= 0) throw InputError(path, "", "not an HDF5 file");
   auto reader = std::make_unique<FrameReader>();
-  reader->file = Handle(hdf5::openReadOnlyWaitingForWriter(path));
+  reader->file = Handle(h5::openReadOnlyWaitingForWriter(path));
   if (!reader->file.valid()) {
     throw InputError(path, "", "cannot be opened as HDF5 (damaged, or held open for writing for over a minute)");
   }
@@ -292,11 +292,11 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   reader->uG = openFloatDataset(reader->file, layout::uG, vec, v, &nG);
   hsize_t n = std::min({nA, nP, nG});
   const bool noSpread = std::none_of(std::begin(kVelocitySpreadFields), std::end(kVelocitySpreadFields),
-                                     [&](const OptionalFrameField& f) { return hdf5::linkExists(reader->file, f.path); });
+                                     [&](const OptionalFrameField& f) { return h5::linkExists(reader->file, f.path); });
   if (storage.velocitySpread && !(storage.velocitySpreadIfPresent && noSpread)) {
     for (std::size_t k = 0; k < std::size(kVelocitySpreadFields); ++k) {
       const auto& f = kVelocitySpreadFields[k];
-      if (!hdf5::linkExists(reader->file, f.path)) {
+      if (!h5::linkExists(reader->file, f.path)) {
         v.push_back({f.path, "dataset is missing: the velocity spread (velocity_streams, langevin_velocity) needs it; the database "
                              "job writes it, a database from elsewhere can add it (docs/formats.md)"});
         continue;
@@ -312,7 +312,7 @@ std::shared_ptr<FieldDatabase> FieldDatabase::open(const std::string& path, Fram
   // (a writer interrupted inside a frame may have extended a dataset without filling it).
   {
     Handle frames(H5Oopen(reader->file, layout::frames, H5P_DEFAULT));
-    if (auto count = hdf5::readNumericAttribute(frames, layout::frameCountAttribute);
+    if (auto count = h5::readNumericAttribute(frames, layout::frameCountAttribute);
         count && count->size() == 1 && (*count)[0] >= 0) {
       n = std::min<hsize_t>(n, hsize_t((*count)[0]));
     }

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "core/Errors.hpp"
-#include "fields/Hdf5.hpp"
+#include "core/Hdf5.hpp"
 
 namespace rcfd {
 
@@ -21,13 +21,13 @@ bool isHdf5Name(const std::string& path) {
 RecurrencePath readPathFile(const std::string& path) {
   RecurrencePath out;
   if (isHdf5Name(path)) {
-    hdf5::silenceErrors();
+    h5::silenceErrors();
     if (H5Fis_hdf5(path.c_str()) <= 0) throw InputError(path, "", "not an HDF5 file (or missing)");
-    hdf5::Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
-    if (!file.valid() || !hdf5::linkExists(file, "/path")) throw InputError(path, "/path", "dataset is missing");
-    hdf5::Handle set(H5Dopen2(file, "/path", H5P_DEFAULT));
-    const auto dims = hdf5::datasetDims(set);
-    if (dims.size() != 1 || hdf5::datasetClass(set) != H5T_INTEGER) {
+    h5::Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+    if (!file.valid() || !h5::linkExists(file, "/path")) throw InputError(path, "/path", "dataset is missing");
+    h5::Handle set(H5Dopen2(file, "/path", H5P_DEFAULT));
+    const auto dims = h5::datasetDims(set);
+    if (dims.size() != 1 || h5::datasetClass(set) != H5T_INTEGER) {
       throw InputError(path, "/path", "must be a 1-D integer dataset of frame indices");
     }
     std::vector<long long> values(dims[0]);
@@ -74,16 +74,16 @@ RecurrencePath readPathFile(const std::string& path) {
 
 void writePathFile(const std::string& path, const RecurrencePath& recurrencePath) {
   if (isHdf5Name(path)) {
-    hdf5::silenceErrors();
-    hdf5::Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+    h5::silenceErrors();
+    h5::Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
     if (!file.valid()) throw RunError(path + ": cannot create the path file");
     const hsize_t n = recurrencePath.frames.size();
-    hdf5::Handle space = hdf5::check(H5Screate_simple(1, &n, nullptr), path);
-    hdf5::Handle set = hdf5::check(
+    h5::Handle space = h5::check(H5Screate_simple(1, &n, nullptr), path);
+    h5::Handle set = h5::check(
         H5Dcreate2(file, "/path", H5T_STD_I32LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path);
     if (n > 0)
-      hdf5::checkStatus(H5Dwrite(set, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, recurrencePath.frames.data()),
-                        path + ": writing /path");
+      h5::checkStatus(H5Dwrite(set, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, recurrencePath.frames.data()),
+                      path + ": writing /path");
     return;
   }
   std::ofstream out(path);

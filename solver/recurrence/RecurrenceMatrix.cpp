@@ -11,7 +11,7 @@
 #include <type_traits>
 
 #include "core/Errors.hpp"
-#include "fields/Hdf5.hpp"
+#include "core/Hdf5.hpp"
 
 namespace rcfd {
 
@@ -432,39 +432,39 @@ RecurrenceMatrix computeRecurrenceMatrix(const FieldDatabase& db, const Recurren
 }
 
 void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatrix& matrix) {
-  using hdf5::Handle;
-  hdf5::silenceErrors();
+  using h5::Handle;
+  h5::silenceErrors();
   Handle file(H5Fopen(databasePath.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
   if (!file.valid()) {
     throw RunError(databasePath + ": cannot open for writing /recurrence/matrix (read-only, or open "
                                   "elsewhere)");
   }
-  if (!hdf5::linkExists(file, "/recurrence")) {
-    Handle g = hdf5::check(H5Gcreate2(file, "/recurrence", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                           databasePath + ": creating /recurrence");
+  if (!h5::linkExists(file, "/recurrence")) {
+    Handle g = h5::check(H5Gcreate2(file, "/recurrence", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                         databasePath + ": creating /recurrence");
   }
   const hsize_t dims[2] = {hsize_t(matrix.R.rows()), hsize_t(matrix.R.cols())};
   Handle set;
-  if (hdf5::linkExists(file, layout::recurrenceMatrix)) {
+  if (h5::linkExists(file, layout::recurrenceMatrix)) {
     set = Handle(H5Dopen2(file, layout::recurrenceMatrix, H5P_DEFAULT));
-    const auto old = set.valid() ? hdf5::datasetDims(set) : std::vector<hsize_t>{};
+    const auto old = set.valid() ? h5::datasetDims(set) : std::vector<hsize_t>{};
     if (old != std::vector<hsize_t>{dims[0], dims[1]}) {
       set.reset();
       H5Ldelete(file, layout::recurrenceMatrix, H5P_DEFAULT);
     }
   }
   if (!set.valid()) {
-    Handle space = hdf5::check(H5Screate_simple(2, dims, nullptr), "/recurrence/matrix");
-    set = hdf5::check(H5Dcreate2(file, layout::recurrenceMatrix, H5T_IEEE_F32LE, space, H5P_DEFAULT,
-                                 H5P_DEFAULT, H5P_DEFAULT),
-                      databasePath + ": creating /recurrence/matrix");
+    Handle space = h5::check(H5Screate_simple(2, dims, nullptr), "/recurrence/matrix");
+    set = h5::check(H5Dcreate2(file, layout::recurrenceMatrix, H5T_IEEE_F32LE, space, H5P_DEFAULT,
+                               H5P_DEFAULT, H5P_DEFAULT),
+                    databasePath + ": creating /recurrence/matrix");
   }
   // R is symmetric, so Eigen's column-major storage is also the row-major [N][N] layout.
-  hdf5::checkStatus(H5Dwrite(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, matrix.R.data()),
-                    databasePath + ": writing /recurrence/matrix");
-  hdf5::writeStringAttribute(set, "norm", toString(matrix.norm));
-  hdf5::writeStringAttribute(set, "field", matrix.field);
-  hdf5::writeDoubleAttribute(set, "normalisation", {matrix.normalisation});
+  h5::checkStatus(H5Dwrite(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, matrix.R.data()),
+                  databasePath + ": writing /recurrence/matrix");
+  h5::writeStringAttribute(set, "norm", toString(matrix.norm));
+  h5::writeStringAttribute(set, "field", matrix.field);
+  h5::writeDoubleAttribute(set, "normalisation", {matrix.normalisation});
   set.reset();
   if (H5Fclose(file.release()) < 0) throw RunError(databasePath + ": closing after writing the matrix failed");
 }
@@ -472,35 +472,35 @@ void storeRecurrenceMatrix(const std::string& databasePath, const RecurrenceMatr
 namespace {
 /// The stored matrix's dataset if it is one of `expectedFrames` squared floats (an invalid handle
 /// otherwise); `file` receives the open file.
-hdf5::Handle storedMatrixSet(const std::string& databasePath, int expectedFrames, hdf5::Handle& file) {
-  using hdf5::Handle;
-  hdf5::silenceErrors();
-  file = Handle(hdf5::openReadOnlyWaitingForWriter(databasePath));
-  if (!file.valid() || !hdf5::linkExists(file, layout::recurrenceMatrix)) return Handle();
+h5::Handle storedMatrixSet(const std::string& databasePath, int expectedFrames, h5::Handle& file) {
+  using h5::Handle;
+  h5::silenceErrors();
+  file = Handle(h5::openReadOnlyWaitingForWriter(databasePath));
+  if (!file.valid() || !h5::linkExists(file, layout::recurrenceMatrix)) return Handle();
   Handle set(H5Dopen2(file, layout::recurrenceMatrix, H5P_DEFAULT));
-  if (!set.valid() || hdf5::datasetClass(set) != H5T_FLOAT) return Handle();
-  if (hdf5::datasetDims(set) != std::vector<hsize_t>{hsize_t(expectedFrames), hsize_t(expectedFrames)})
+  if (!set.valid() || h5::datasetClass(set) != H5T_FLOAT) return Handle();
+  if (h5::datasetDims(set) != std::vector<hsize_t>{hsize_t(expectedFrames), hsize_t(expectedFrames)})
     return Handle();
   return set;
 }
 }  // namespace
 
 bool hasStoredRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
-  hdf5::Handle file;
+  h5::Handle file;
   return storedMatrixSet(databasePath, expectedFrames, file).valid();
 }
 
 std::optional<RecurrenceMatrix> loadRecurrenceMatrix(const std::string& databasePath, int expectedFrames) {
-  hdf5::Handle file;
-  const hdf5::Handle set = storedMatrixSet(databasePath, expectedFrames, file);
+  h5::Handle file;
+  const h5::Handle set = storedMatrixSet(databasePath, expectedFrames, file);
   if (!set.valid()) return std::nullopt;
   RecurrenceMatrix m;
   Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> R(expectedFrames, expectedFrames);
   if (H5Dread(set, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, R.data()) < 0) return std::nullopt;
   m.R = R;
-  if (auto n = hdf5::readStringAttribute(set, "norm")) m.norm = parseRecurrenceNorm(*n, "/recurrence/matrix@norm");
-  if (auto f = hdf5::readStringAttribute(set, "field")) m.field = *f;
-  if (auto v = hdf5::readNumericAttribute(set, "normalisation"); v && v->size() == 1) m.normalisation = (*v)[0];
+  if (auto n = h5::readStringAttribute(set, "norm")) m.norm = parseRecurrenceNorm(*n, "/recurrence/matrix@norm");
+  if (auto f = h5::readStringAttribute(set, "field")) m.field = *f;
+  if (auto v = h5::readNumericAttribute(set, "normalisation"); v && v->size() == 1) m.normalisation = (*v)[0];
   return m;
 }
 

@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "FieldTestUtil.hpp"
-#include "fields/Hdf5.hpp"
+#include "core/Hdf5.hpp"
 
 using namespace rcfd;
 using namespace rcfd::test;
@@ -43,25 +43,25 @@ TEST(FieldDatabase, RoundTripKeepsEveryValue) {
 TEST(FieldDatabase, FileFollowsTheContractLayout) {
   const CartesianGrid g = smallGrid(5, 3, 2);
   const std::string path = writeWavyDatabase("layout.h5", g, 3);
-  hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  h5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
   ASSERT_TRUE(f.valid());
-  EXPECT_EQ(hdf5::readStringAttribute(f, "format").value(), "rcfd-field-database");
-  EXPECT_EQ(hdf5::readNumericAttribute(f, "version").value(), std::vector<double>{1});
-  hdf5::Handle grid(H5Oopen(f, "/grid", H5P_DEFAULT));
-  EXPECT_EQ(hdf5::readNumericAttribute(grid, "shape").value(), (std::vector<double>{5, 3, 2}));
+  EXPECT_EQ(h5::readStringAttribute(f, "format").value(), "rcfd-field-database");
+  EXPECT_EQ(h5::readNumericAttribute(f, "version").value(), std::vector<double>{1});
+  h5::Handle grid(H5Oopen(f, "/grid", H5P_DEFAULT));
+  EXPECT_EQ(h5::readNumericAttribute(grid, "shape").value(), (std::vector<double>{5, 3, 2}));
   struct Expect {
     const char* name;
     std::vector<hsize_t> dims;
   };
   for (const Expect& e : {Expect{"/grid/fluid_fraction", {2, 3, 5}}, Expect{"/frames/alpha_p", {3, 2, 3, 5}},
                           Expect{"/frames/u_p", {3, 2, 3, 5, 3}}, Expect{"/frames/u_g", {3, 2, 3, 5, 3}}}) {
-    hdf5::Handle d(H5Dopen2(f, e.name, H5P_DEFAULT));
+    h5::Handle d(H5Dopen2(f, e.name, H5P_DEFAULT));
     ASSERT_TRUE(d.valid()) << e.name;
-    EXPECT_EQ(hdf5::datasetDims(d), e.dims) << e.name;
-    hdf5::Handle type(H5Dget_type(d));
+    EXPECT_EQ(h5::datasetDims(d), e.dims) << e.name;
+    h5::Handle type(H5Dget_type(d));
     EXPECT_TRUE(H5Tequal(type, H5T_IEEE_F32LE) > 0) << e.name << " is not float32";
     if (std::string(e.name).rfind("/frames/", 0) == 0) {
-      hdf5::Handle plist(H5Dget_create_plist(d));
+      h5::Handle plist(H5Dget_create_plist(d));
       ASSERT_EQ(H5Pget_layout(plist), H5D_CHUNKED) << e.name;
       std::vector<hsize_t> chunk(e.dims.size());
       H5Pget_chunk(plist, int(chunk.size()), chunk.data());
@@ -107,17 +107,17 @@ TEST(FieldDatabase, PartiallyWrittenFrameIsIgnored) {
   const CartesianGrid g = smallGrid(4, 3, 2);
   const std::string path = writeWavyDatabase("partial.h5", g, 4);
   {
-    hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    h5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
     for (const char* name : {"/frames/alpha_p", "/frames/u_p"}) {
-      hdf5::Handle d(H5Dopen2(f, name, H5P_DEFAULT));
-      auto dims = hdf5::datasetDims(d);
+      h5::Handle d(H5Dopen2(f, name, H5P_DEFAULT));
+      auto dims = h5::datasetDims(d);
       dims[0] = 5;
       ASSERT_GE(H5Dset_extent(d, dims.data()), 0);
     }
   }
   EXPECT_EQ(FieldDatabase::open(path)->frameCount(), 4);  // frame_count = 4
   {
-    hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    h5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
     ASSERT_GE(H5Adelete_by_name(f, "/frames", "frame_count", H5P_DEFAULT), 0);
   }
   EXPECT_EQ(FieldDatabase::open(path)->frameCount(), 4);  // u_g has 4 frames

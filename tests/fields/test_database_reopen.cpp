@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "FieldTestUtil.hpp"
-#include "fields/Hdf5.hpp"
+#include "core/Hdf5.hpp"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,9 +18,9 @@ TEST(FieldDatabaseReopen, CutsBackToTheKeptFramesAndAppendsAfterThem) {
   const CartesianGrid g = smallGrid(4, 3, 2);
   const std::string path = writeWavyDatabase("reopen.h5", g, 6);
   {
-    hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
-    hdf5::Handle g(H5Gcreate2(f, "/recurrence", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    hdf5::writeStringDataset(f, "/recurrence/matrix", "stale");  // any object there: reopen removes it
+    h5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT));
+    h5::Handle g(H5Gcreate2(f, "/recurrence", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    h5::writeStringDataset(f, "/recurrence/matrix", "stale");  // any object there: reopen removes it
   }
   {
     auto w = FieldDatabaseWriter::reopen(path, g, 4);
@@ -44,8 +44,8 @@ TEST(FieldDatabaseReopen, CutsBackToTheKeptFramesAndAppendsAfterThem) {
   EXPECT_EQ(db->frame(4)->u_p, appended.u_p);
   EXPECT_EQ(db->fluidFraction(), variedFluid(g));
   EXPECT_DOUBLE_EQ(db->dtRec(), 0.005);
-  hdf5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
-  EXPECT_FALSE(hdf5::linkExists(f, "/recurrence/matrix"));
+  h5::Handle f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  EXPECT_FALSE(h5::linkExists(f, "/recurrence/matrix"));
 }
 
 TEST(FieldDatabaseReopen, KeepingZeroFramesStartsOver) {

@@ -45,6 +45,14 @@ inline std::shared_ptr<FieldDatabase> database(const Scene& s, int frames, doubl
   return makeAnalyticDatabase(grid, fluid, dtRec, frames, fill);
 }
 
+/// Gives frame f the optional velocity-spread datasets, zero, for a grid of `cells` cells.
+inline void zeroVelocitySpread(FieldFrame& f, std::size_t cells) {
+  f.up_fraction.assign(cells, 0.0f);
+  f.u_p_up.assign(3 * cells, 0.0f);
+  f.u_p_down.assign(3 * cells, 0.0f);
+  f.u_p_variance.assign(3 * cells, 0.0f);
+}
+
 /// The path 0, 1, 2, ... (mod frames) of `length` entries: one long sequence, wrapping with a jump.
 inline RecurrencePath sequentialPath(int frames, std::int64_t length) {
   RecurrencePath p;

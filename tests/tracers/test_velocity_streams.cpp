@@ -49,10 +49,7 @@ struct BouncingBalls {
   /// The frame of a grid: stationary.
   void fill(const CartesianGrid& grid, FieldFrame& f) const {
     const std::size_t cells = std::size_t(grid.cellCount());
-    f.up_fraction.assign(cells, 0.0f);
-    f.u_p_up.assign(3 * cells, 0.0f);
-    f.u_p_down.assign(3 * cells, 0.0f);
-    f.u_p_variance.assign(3 * cells, 0.0f);
+    zeroVelocitySpread(f, cells);
     // alpha proportional to the time spent per height, normalised over the layer below the apex.
     const double norm = alphaMean * apex() / timeThrough(0.0, apex());
     for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
