@@ -153,48 +153,27 @@ Apparatus::Apparatus(const ApparatusSpec& spec) : spec_(spec) {
     }
     if (!bad.empty()) throw InputError("apparatus", bad);
     const double y0 = dp.elevation, y1 = dp.elevation + dp.height;
-    setPlates({{Vector2d(-outer, y0), Vector2d(-inner, y1)}, {Vector2d(inner, y0), Vector2d(outer, y1)}});
-  } else {
-    setPlates({});
+    plates_.push_back({Vector2d(-outer, y0), Vector2d(-inner, y1)});
+    plates_.push_back({Vector2d(inner, y0), Vector2d(outer, y1)});
+    platesLo_ = Vector2d(-outer, y0);
+    platesHi_ = Vector2d(outer, y1);
+    for (const auto& pb : plates_) {
+      // Clockwise, so the open region lies on the left of every edge as for the outline.
+      std::vector<Vector2d> hole{{pb.lo.x(), pb.lo.y()}, {pb.lo.x(), pb.hi.y()},
+                                 {pb.hi.x(), pb.hi.y()}, {pb.hi.x(), pb.lo.y()}};
+      for (std::size_t i = 0; i < hole.size(); ++i)
+        edges_.push_back({hole[i], hole[(i + 1) % hole.size()], BoundaryKind::Plate});
+      holes_.push_back(std::move(hole));
+    }
   }
-}
 
-void Apparatus::setPlates(std::vector<PlateBox> plates) {
-  plates_ = std::move(plates);
-  holes_.clear();
-  std::erase_if(edges_, [](const SectionEdge& e) { return e.kind == BoundaryKind::Plate; });
-  platesLo_ = platesHi_ = Vector2d::Zero();
-  for (std::size_t i = 0; i < plates_.size(); ++i) {
-    const PlateBox& pb = plates_[i];
-    platesLo_ = i == 0 ? pb.lo : Vector2d(platesLo_.cwiseMin(pb.lo));
-    platesHi_ = i == 0 ? pb.hi : Vector2d(platesHi_.cwiseMax(pb.hi));
-    // Clockwise, so the open region lies on the left of every edge as for the outline.
-    std::vector<Vector2d> hole{{pb.lo.x(), pb.lo.y()}, {pb.lo.x(), pb.hi.y()},
-                               {pb.hi.x(), pb.hi.y()}, {pb.hi.x(), pb.lo.y()}};
-    for (std::size_t k = 0; k < hole.size(); ++k)
-      edges_.push_back({hole[k], hole[(k + 1) % hole.size()], BoundaryKind::Plate});
-    holes_.push_back(std::move(hole));
-  }
   // Analytic area: the rectangle minus the two triangles under the V walls, minus the plates.
-  if (spec_.type == ApparatusSpec::Type::PrismaticSpoutedBed) {
-    sectionArea_ = spec_.width * spec_.height - 0.5 * (spec_.width - spec_.inlet_width) * yV_;
+  if (spec.type == ApparatusSpec::Type::PrismaticSpoutedBed) {
+    sectionArea_ = spec.width * spec.height - 0.5 * (spec.width - spec.inlet_width) * yV_;
   } else {
-    sectionArea_ = spec_.size.x() * spec_.size.y();
+    sectionArea_ = spec.size.x() * spec.size.y();
   }
   for (const auto& pb : plates_) sectionArea_ -= (pb.hi - pb.lo).prod();
-}
-
-Apparatus Apparatus::withPlates(const std::vector<Eigen::AlignedBox2d>& plates) const {
-  if (plates.size() != plates_.size()) throw std::logic_error("Apparatus::withPlates: one box per plate");
-  std::vector<PlateBox> boxes;
-  for (std::size_t i = 0; i < plates.size(); ++i) {
-    if (!plates[i].contains(Eigen::AlignedBox2d(plates_[i].lo, plates_[i].hi)))
-      throw std::logic_error("Apparatus::withPlates: a plate must contain the one it replaces");
-    boxes.push_back({plates[i].min(), plates[i].max()});
-  }
-  Apparatus out = *this;
-  out.setPlates(std::move(boxes));
-  return out;
 }
 
 Vector3d Apparatus::lowerCorner() const { return Vector3d(lo2_.x(), lo2_.y(), 0.0); }

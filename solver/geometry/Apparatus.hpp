@@ -28,7 +28,6 @@
 /// segment passing a draft plate's tip at less than boundaryTolerance() counts as a hit on the plate.
 
 #include <Eigen/Core>
-#include <Eigen/Geometry>
 #include <optional>
 #include <vector>
 
@@ -124,11 +123,6 @@ class Apparatus {
   /// The draft plates' rectangles (clockwise, so the open region is on the left of every edge) [m].
   const std::vector<std::vector<Eigen::Vector2d>>& holes() const { return holes_; }
 
-  /// The same apparatus with its draft plates replaced by `plates` (one per plate, in the order of
-  /// holes(); each containing the plate it replaces), e.g. the plates as a grid sees them
-  /// (platesOnGrid, geometry/ThinWalls.hpp).
-  Apparatus withPlates(const std::vector<Eigen::AlignedBox2d>& plates) const;
-
  private:
   /// One edge of the convex outline as a half-plane: n . p - c >= 0 inside, n the unit inward normal.
   struct HalfPlane {
@@ -140,8 +134,6 @@ class Apparatus {
   struct PlateBox {
     Eigen::Vector2d lo, hi;
   };
-  /// Sets plates_ and what follows from them: holes_, their edges, the section area, the plates' box.
-  void setPlates(std::vector<PlateBox> plates);
   /// Signed 2D distance to the cross-section (> 0 inside) with the nearest point, normal and kind.
   double section2d(const Eigen::Vector2d& p, Eigen::Vector2d& q, Eigen::Vector2d& n,
                    BoundaryKind& kind) const;

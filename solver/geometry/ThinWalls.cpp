@@ -101,22 +101,6 @@ std::vector<std::uint8_t> plateFacesAbove(const Apparatus& apparatus, const Cart
   return out;
 }
 
-std::vector<Eigen::AlignedBox2d> platesOnGrid(const Apparatus& apparatus, const CartesianGrid& grid) {
-  std::vector<Eigen::AlignedBox2d> out;
-  for (const auto& hole : apparatus.holes()) {
-    Eigen::Vector2d lo, hi;
-    bounds(hole, lo, hi);
-    for (int a = 0; a < 2; ++a) {
-      if (const auto face = snappedFace(lo, hi, a, grid)) {
-        lo[a] = std::min(lo[a], face->second);
-        hi[a] = std::max(hi[a], face->second);
-      }
-    }
-    out.emplace_back(lo, hi);
-  }
-  return out;
-}
-
 bool plateSeparates(const Apparatus& apparatus, const CartesianGrid& grid, const BaffleFaces& baffles,
                     const std::array<int, 3>& ijk, int d, int side) {
   if (d > 1) return false;

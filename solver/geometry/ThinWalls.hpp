@@ -11,12 +11,9 @@
 ///
 /// Snapping leaves a strip of the plate's cell column between the plate and the baffle face on the
 /// baffle's wrong side: a particle there lies beyond the plate, but its cell is on this side of the
-/// baffle. The grid's picture of the plate is the plate widened to the baffle face (platesOnGrid), and
-/// a point in the strip belongs to the cell across the face (BaffleFaces::homeCell): the database's
-/// mapping puts such a particle's volume there, and the tracers, which live on the grid, do not enter
-/// the strip.
+/// baffle. A point in the strip belongs to the cell across the face (BaffleFaces::homeCell): the
+/// database's mapping puts such a particle's volume there.
 
-#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -81,10 +78,6 @@ BaffleFaces thinWallBaffles(const Apparatus& apparatus, const CartesianGrid& gri
 /// (tracers/Trilinear.hpp). Empty for an apparatus without plates.
 inline constexpr std::uint8_t kPlateAboveX = 1, kPlateAboveY = 2;
 std::vector<std::uint8_t> plateFacesAbove(const Apparatus& apparatus, const CartesianGrid& grid);
-
-/// The draft plates as the grid sees them, in the order of Apparatus::holes(): a plate snapped to a
-/// baffle face widened along its thin axis to that face, the others as they are. The tracers' walls.
-std::vector<Eigen::AlignedBox2d> platesOnGrid(const Apparatus& apparatus, const CartesianGrid& grid);
 
 /// Whether a plate separates cell `ijk` from its neighbour along axis d (0: x, 1: y; -1 or +1 for
 /// `side`) as the CFD-DEM's mapping, smoothing and gas see it: a plate that contains the face between

@@ -45,11 +45,7 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   }
   const auto effects = TracerEffectRegistry::resolve(scene_.effects);
 
-  // The tracers live on the database's grid: a plate thinner than a cell is where the frames put it,
-  // widened to its baffle face (geometry/ThinWalls.hpp), so no tracer enters the strip the frames
-  // count on the plate's other side.
-  const Apparatus exact(scene_.apparatus);
-  apparatus_ = std::make_unique<Apparatus>(exact.withPlates(platesOnGrid(exact, database_->grid())));
+  apparatus_ = std::make_unique<Apparatus>(scene_.apparatus);
   cloud_.resize(std::size_t(scene_.rcfd.tracers));
   const auto& p = scene_.particles;
   cloud_.particleVolume = std::numbers::pi / 6.0 * p.diameter * p.diameter * p.diameter;

@@ -21,9 +21,9 @@ namespace rcfd {
 /// The stencil (base, fractions) of a point kept on its side of the plates: along x (or y), when a
 /// plate closes the face between the stencil's two centres in the point's own row (layer), the fraction
 /// becomes that of the point's own centre, 0 or 1: the value up to the plate is its own side's, held
-/// constant, as beyond the outermost centres. The point's side is that of its cell (fraction >= 1/2),
-/// exact for points outside the strips between a plate and its face (the tracers: their walls are
-/// platesOnGrid).
+/// constant, as beyond the outermost centres. The point's side is that of its cell (fraction >= 1/2);
+/// in the strip between a plate and its baffle face (geometry/ThinWalls.hpp) that is the baffle's near
+/// side.
 template <class T>
 inline void keepStencilOnPlateSide(const std::uint8_t* plates, std::int32_t base, std::int32_t sy, std::int32_t sz,
                                    T& fx, T& fy, T fz) {
