@@ -8,7 +8,6 @@
 // latency). Extra server arguments come from RCFD_BENCH_SERVER_ARGS (e.g. "--io-threads 1"), and
 // RCFD_BENCH_SERVER_WRAPPER runs the server under a tool ("valgrind --tool=callgrind").
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <boost/beast/http.hpp>
@@ -19,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "../tests/server/ChildProcess.hpp"
 #include "../tests/server/LoadGenerator.hpp"
 #include "../tests/server/SmallDatabase.hpp"
 #include "BenchRegistry.hpp"
@@ -127,25 +127,11 @@ nlohmann::json run(const Options& options) {
   args.insert(args.end(), extra.begin(), extra.end());
   const auto wrapper = splitWords(std::getenv("RCFD_BENCH_SERVER_WRAPPER"));  // e.g. valgrind
   args.insert(args.begin(), wrapper.begin(), wrapper.end());
-  int out[2];
-  if (::pipe(out) != 0) throw std::runtime_error("pipe");
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::dup2(out[1], 1);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execvp(argv[0], argv.data());
-    ::_exit(127);
-  }
-  ::close(out[1]);
-  std::string line;
-  char c;
-  while (::read(out[0], &c, 1) == 1 && c != '\n') line.push_back(c);
-  ::close(out[0]);
-  if (line.rfind("listening on http://", 0) != 0)
+  rcfd::test::ServerChild server(rcfd::test::ServerCommand(std::move(args)));
+  if (!server.listening() || server.tls())  // the benchmark's requests are plain HTTP
     throw std::runtime_error("rcfd-server did not start (build rcfd-server and rcfd-solve beside rcfd-bench)");
-  const auto port = static_cast<unsigned short>(std::stoi(line.substr(line.rfind(':') + 1)));
+  const auto port = server.port();
+  const pid_t pid = server.pid();
 
   std::ifstream dbFile(dir / "db.h5", std::ios::binary);
   const std::string dbBytes((std::istreambuf_iterator<char>(dbFile)), {});
@@ -193,9 +179,7 @@ nlohmann::json run(const Options& options) {
   const auto idle = measure(pid, port, token, target, seconds, std::chrono::milliseconds(100));
   print("polling every 100 ms, no job running (the cancelled job)", idle);
 
-  ::kill(pid, SIGTERM);
-  int exitStatus = 0;
-  ::waitpid(pid, &exitStatus, 0);
+  server.stop(SIGTERM);
   std::filesystem::remove_all(dir);
   return {{"clients", kClients},
           {"seconds_each", seconds.count()},

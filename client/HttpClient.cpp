@@ -164,6 +164,18 @@ void close(net::io_context& ioc, TlsStream& stream) {
   beast::get_lowest_layer(stream).socket().close(ignored);
 }
 
+/// A request with the headers every request of the client carries, in this order: the host, the
+/// content type (none: `contentType` null) and the bearer token (none: `token` empty).
+template <class Body>
+http::request<Body> newRequest(http::verb method, const std::string& target, const std::string& host,
+                               const std::string& token, const char* contentType = nullptr) {
+  http::request<Body> req{method, target, 11};
+  req.set(http::field::host, host);
+  if (contentType) req.set(http::field::content_type, contentType);
+  if (!token.empty()) req.set(http::field::authorization, "Bearer " + token);
+  return req;
+}
+
 template <class Stream, class RequestBody, class ResponseParser>
 void exchange(net::io_context& ioc, Stream& stream, http::request<RequestBody>& req, ResponseParser& parser,
               const std::string& server, std::chrono::seconds timeout) {
@@ -199,10 +211,8 @@ void HttpClient::withConnection(Exchange&& exchange) {
   }
 }
 
-HttpResponse HttpClient::get(const std::string& target) {
-  http::request<http::empty_body> req{http::verb::get, target, 11};
-  req.set(http::field::host, host_);
-  if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
+template <class Request>
+HttpResponse HttpClient::sendAndRead(Request& req) {
   http::response_parser<http::string_body> parser;
   parser.body_limit(kMaxResponseBody);
   withConnection([&](net::io_context& ioc, auto& stream) { exchange(ioc, stream, req, parser, server_, timeout_); });
@@ -211,50 +221,34 @@ HttpResponse HttpClient::get(const std::string& target) {
   copyHeaders(parser.get(), out);
   out.body = parser.get().body();
   return out;
+}
+
+HttpResponse HttpClient::get(const std::string& target) {
+  auto req = newRequest<http::empty_body>(http::verb::get, target, host_, token_);
+  return sendAndRead(req);
 }
 
 HttpResponse HttpClient::post(const std::string& target, const std::string& jsonBody,
                               const std::map<std::string, std::string>& headers) {
-  http::request<http::string_body> req{http::verb::post, target, 11};
-  req.set(http::field::host, host_);
-  req.set(http::field::content_type, "application/json");
-  if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
+  auto req = newRequest<http::string_body>(http::verb::post, target, host_, token_, "application/json");
   for (const auto& [k, v] : headers) req.set(k, v);
   req.body() = jsonBody;
-  http::response_parser<http::string_body> parser;
-  parser.body_limit(kMaxResponseBody);
-  withConnection([&](net::io_context& ioc, auto& stream) { exchange(ioc, stream, req, parser, server_, timeout_); });
-  HttpResponse out;
-  out.status = parser.get().result_int();
-  copyHeaders(parser.get(), out);
-  out.body = parser.get().body();
-  return out;
+  return sendAndRead(req);
 }
 
 HttpResponse HttpClient::postFile(const std::string& target, const std::filesystem::path& file) {
-  http::request<http::file_body> req{http::verb::post, target, 11};
-  req.set(http::field::host, host_);
-  req.set(http::field::content_type, "application/x-hdf5");
-  if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
+  auto req = newRequest<http::file_body>(http::verb::post, target, host_, token_, "application/x-hdf5");
   beast::error_code ec;
   req.body().open(file.c_str(), beast::file_mode::scan, ec);
   if (ec) throw std::runtime_error("cannot read " + file.string() + ": " + ec.message());
-  http::response_parser<http::string_body> parser;
-  withConnection([&](net::io_context& ioc, auto& stream) { exchange(ioc, stream, req, parser, server_, timeout_); });
-  HttpResponse out;
-  out.status = parser.get().result_int();
-  copyHeaders(parser.get(), out);
-  out.body = parser.get().body();
-  return out;
+  return sendAndRead(req);
 }
 
 HttpResponse HttpClient::download(const std::string& target, const std::filesystem::path& file) {
   HttpResponse out;
   withConnection([&](net::io_context& ioc, auto& stream) {
     // Read the header first: only a 2xx body goes to the file, an error body stays in memory.
-    http::request<http::empty_body> req{http::verb::get, target, 11};
-    req.set(http::field::host, host_);
-    if (!token_.empty()) req.set(http::field::authorization, "Bearer " + token_);
+    auto req = newRequest<http::empty_body>(http::verb::get, target, host_, token_);
     auto ec = runFor(ioc, stream, timeout_, [&](auto&& done) { http::async_write(stream, req, done); });
     if (ec) throw ConnectionError("cannot send to " + server_ + ": " + failure(ec, timeout_));
     beast::flat_buffer buffer;

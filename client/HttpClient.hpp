@@ -58,6 +58,10 @@ class HttpClient {
   /// connection's stream and closes it; every step within the timeout.
   template <class Exchange>
   void withConnection(Exchange&& exchange);
+  /// Sends `request` on a new connection and reads the whole answer into memory: what get, post and
+  /// postFile share (download streams its answer and has its own exchange).
+  template <class Request>
+  HttpResponse sendAndRead(Request& request);
 
   std::string server_, host_, port_, token_;
   std::chrono::seconds timeout_;

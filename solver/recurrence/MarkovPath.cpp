@@ -11,6 +11,7 @@
 #include "recurrence/PathRandom.hpp"
 #include "recurrence/PathSupport.hpp"
 #include "recurrence/RecurrencePath.hpp"
+#include "recurrence/SequenceWalk.hpp"
 
 namespace rcfd {
 namespace {
@@ -80,22 +81,7 @@ class MarkovPathGenerator final : public PathGenerator {
       return 1;
     };
 
-    RecurrencePath path;
-    path.frames.resize(std::size_t(steps));
-    if (steps == 0) return path;
-    int current = int(path_random::uniformInt(rng, 0, n - 2));
-    std::int64_t remaining = drawLength();
-    for (std::int64_t s = 0; s < steps; ++s) {
-      path.frames[std::size_t(s)] = current;
-      --remaining;
-      if (remaining <= 0 || current == n - 1) {
-        current = jumpFrom(current);
-        remaining = drawLength();
-      } else {
-        ++current;
-      }
-    }
-    return path;
+    return walkSequences(n, steps, rng, jumpFrom, drawLength);
   }
 
  private:

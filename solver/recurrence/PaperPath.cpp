@@ -11,6 +11,7 @@
 #include "recurrence/PathRandom.hpp"
 #include "recurrence/PathSupport.hpp"
 #include "recurrence/RecurrencePath.hpp"
+#include "recurrence/SequenceWalk.hpp"
 
 namespace rcfd {
 namespace {
@@ -40,22 +41,9 @@ class PaperPathGenerator final : public PathGenerator {
     }
 
     std::mt19937_64 rng(seed);
-    RecurrencePath path;
-    path.frames.resize(std::size_t(steps));
-    if (steps == 0) return path;
-    int current = int(path_random::uniformInt(rng, 0, n - 2));
-    std::int64_t remaining = path_random::uniformInt(rng, shortest, longest);
-    for (std::int64_t s = 0; s < steps; ++s) {
-      path.frames[std::size_t(s)] = current;
-      --remaining;
-      if (remaining <= 0 || current == n - 1) {
-        current = next[std::size_t(current)];
-        remaining = path_random::uniformInt(rng, shortest, longest);
-      } else {
-        ++current;
-      }
-    }
-    return path;
+    return walkSequences(
+        n, steps, rng, [&](int e) { return next[std::size_t(e)]; },
+        [&] { return path_random::uniformInt(rng, shortest, longest); });
   }
 
  private:

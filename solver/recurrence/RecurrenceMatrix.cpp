@@ -136,6 +136,51 @@ void loadFrames(const ScalarSeries& s, int first, int count, Store store, const 
   stop.throwIfStopped();
 }
 
+// The tile pairs (a, b) of a block pair, row by row; on a diagonal block (rows and columns the same
+// frames) only b >= a, since D is symmetric. The work estimate of distanceMatrix() goes through them in
+// the same order.
+std::vector<std::pair<int, int>> tilePairs(std::size_t rowTiles, std::size_t columnTiles, bool diagonalBlock) {
+  std::vector<std::pair<int, int>> pairs;
+  for (int a = 0; a < int(rowTiles); ++a)
+    for (int b = diagonalBlock ? a : 0; b < int(columnTiles); ++b) pairs.emplace_back(a, b);
+  return pairs;
+}
+
+// The blocked loop over pairs of frames that both distance forms share. The frames are split into
+// blocks of `framesPerBlock` for memory: for every block pair on or above the diagonal the rows' block
+// X and the columns' block Y are resident, each filled by `load(first, count, matrix)` with one column
+// per frame. Each block pair is split into tiles of `tileFrames` frames, and
+// `tilePair(X, Y, a, b, rowFrame, columnFrame)` computes the entries of tile a of X against tile b of
+// Y, whose first columns are frames rowFrame and columnFrame; tiles below the diagonal are skipped.
+// Tiles are independent and run in parallel, each on one thread (Eigen's GEMM does not nest inside an
+// active omp parallel region), which keeps both cores busy even when other processes share them. A
+// stop request is polled before every tile and thrown after the parallel loop (StopPoll).
+template <class Matrix, class Load, class TilePair>
+void forEachTilePair(int frames, int framesPerBlock, int tileFrames, Eigen::Index cells, Load&& load,
+                     TilePair&& tilePair, const StopPoll& stop) {
+  const auto blocks = tiles(0, frames, framesPerBlock);
+  Matrix XP, XQ;
+  for (std::size_t p = 0; p < blocks.size(); ++p) {
+    load(blocks[p].first, blocks[p].count, XP);
+    for (std::size_t q = p; q < blocks.size(); ++q) {
+      if (q != p) load(blocks[q].first, blocks[q].count, XQ);
+      const Matrix& Y = q == p ? XP : XQ;
+      const auto tp = tiles(0, blocks[p].count, tileFrames);
+      const auto tq = tiles(0, blocks[q].count, tileFrames);
+      const auto pairs = tilePairs(tp.size(), tq.size(), q == p);
+#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
+      for (int k = 0; k < int(pairs.size()); ++k) {
+        if (stop()) continue;
+        const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
+        const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
+        tilePair(XP, Y, a, b, blocks[p].first, blocks[q].first);
+        stop.advance(kEntryWork * a.count * b.count);
+      }
+      stop.throwIfStopped();
+    }
+  }
+}
+
 // Gram form of the L2 distances. Frames are centred on frame 0 (D is unchanged, (a_i - r) - (a_j - r)
 // = a_i - a_j) so n_i + n_j - 2 G_ij cancels less, then scaled by sqrt(V_c): G_ij = sum_c V_c x_i x_j.
 // Scalar = double: one double GEMM per tile pair. Scalar = float: float GEMMs over chunks of
@@ -169,43 +214,22 @@ Eigen::MatrixXd l2Distances(const ScalarSeries& s, int framesPerBlock, int tileF
   };
 
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);  // upper triangle filled
-  const auto blocks = tiles(0, n, framesPerBlock);
-  Matrix XP, XQ;
-  for (std::size_t p = 0; p < blocks.size(); ++p) {
-    load(blocks[p].first, blocks[p].count, XP);
-    for (std::size_t q = p; q < blocks.size(); ++q) {
-      if (q != p) load(blocks[q].first, blocks[q].count, XQ);
-      const Matrix& Y = q == p ? XP : XQ;
-      const auto tp = tiles(0, blocks[p].count, tileFrames);
-      const auto tq = tiles(0, blocks[q].count, tileFrames);
-      std::vector<std::pair<int, int>> pairs;
-      for (int a = 0; a < int(tp.size()); ++a)
-        for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
-      // Each tile product is single-threaded GEMM (Eigen does not nest inside omp parallel); tiles
-      // are independent, which keeps both cores busy even when other processes share them. Only tiles
-      // on or above the diagonal are computed.
-#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
-      for (int k = 0; k < int(pairs.size()); ++k) {
-        if (stop()) continue;
-        const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
-        const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
-        auto target = G.block(blocks[p].first + a.first, blocks[q].first + b.first, a.count, b.count);
-        if constexpr (std::is_same_v<Scalar, double>) {
-          target.noalias() = XP.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
-        } else {
-          Eigen::MatrixXf partial(a.count, b.count);
-          // Polled per chunk too: one tile over 10^6 cells takes seconds.
-          for (Eigen::Index c0 = 0; c0 < cells && !stop(); c0 += floatChunk) {
-            const Eigen::Index len = std::min(floatChunk, cells - c0);
-            partial.noalias() = XP.block(c0, a.first, len, a.count).transpose() * Y.block(c0, b.first, len, b.count);
-            target += partial.cast<double>();
-          }
-        }
-        stop.advance(kEntryWork * a.count * b.count);
+  // G over one tile pair: one GEMM in double, or float GEMMs per chunk of cells summed in double.
+  auto gramTile = [&](const Matrix& X, const Matrix& Y, Tile a, Tile b, int rowFrame, int columnFrame) {
+    auto target = G.block(rowFrame + a.first, columnFrame + b.first, a.count, b.count);
+    if constexpr (std::is_same_v<Scalar, double>) {
+      target.noalias() = X.middleCols(a.first, a.count).transpose() * Y.middleCols(b.first, b.count);
+    } else {
+      Eigen::MatrixXf partial(a.count, b.count);
+      // Polled per chunk too: one tile over 10^6 cells takes seconds.
+      for (Eigen::Index c0 = 0; c0 < cells && !stop(); c0 += floatChunk) {
+        const Eigen::Index len = std::min(floatChunk, cells - c0);
+        partial.noalias() = X.block(c0, a.first, len, a.count).transpose() * Y.block(c0, b.first, len, b.count);
+        target += partial.cast<double>();
       }
-      stop.throwIfStopped();
     }
-  }
+  };
+  forEachTilePair<Matrix>(n, framesPerBlock, tileFrames, cells, load, gramTile, stop);
   std::int64_t negatives = 0;
   Eigen::MatrixXd& D = G;  // converted in place, upper triangle first
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : negatives) if (n > 512)
@@ -244,59 +268,42 @@ Eigen::MatrixXd directDistances(const ScalarSeries& s, RecurrenceNorm norm, int 
     }, stop);
   };
   Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
-  const auto blocks = tiles(0, n, framesPerBlock);
-  MatrixXfC XP, XQ;
   const bool isMax = norm == RecurrenceNorm::Max;
-  for (std::size_t p = 0; p < blocks.size(); ++p) {
-    load(blocks[p].first, blocks[p].count, XP);
-    for (std::size_t q = p; q < blocks.size(); ++q) {
-      if (q != p) load(blocks[q].first, blocks[q].count, XQ);
-      const MatrixXfC& Y = q == p ? XP : XQ;
-      const auto tp = tiles(0, blocks[p].count, tileFrames);
-      const auto tq = tiles(0, blocks[q].count, tileFrames);
-      std::vector<std::pair<int, int>> pairs;
-      for (int a = 0; a < int(tp.size()); ++a)
-        for (int b = q == p ? a : 0; b < int(tq.size()); ++b) pairs.emplace_back(a, b);
-#pragma omp parallel for schedule(dynamic, 1) if (pairs.size() > 1 && double(blocks[p].count) * blocks[q].count * cells > 1e7)
-      for (int k = 0; k < int(pairs.size()); ++k) {
-        if (stop()) continue;
-        const Tile a = tp[std::size_t(pairs[std::size_t(k)].first)];
-        const Tile b = tq[std::size_t(pairs[std::size_t(k)].second)];
-        Eigen::MatrixXd acc = Eigen::MatrixXd::Zero(a.count, b.count);
-        for (Eigen::Index c0 = 0; c0 < cells; c0 += cellChunk) {
-          const Eigen::Index len = std::min(cellChunk, cells - c0);
-          for (int i = 0; i < a.count; ++i) {
-            const float* xi = XP.col(a.first + i).data() + c0;
-            const int gi = blocks[p].first + a.first + i;
-            for (int j = 0; j < b.count; ++j) {
-              const int gj = blocks[q].first + b.first + j;
-              if (gj <= gi) continue;
-              const float* xj = Y.col(b.first + j).data() + c0;
-              if (isMax) {
-                float m = 0.0f;
+  // One tile pair's entries above the diagonal, accumulated chunk by chunk of cells (the cache
+  // blocking), then written to both triangles.
+  auto distanceTile = [&](const MatrixXfC& X, const MatrixXfC& Y, Tile a, Tile b, int rowFrame, int columnFrame) {
+    Eigen::MatrixXd acc = Eigen::MatrixXd::Zero(a.count, b.count);
+    for (Eigen::Index c0 = 0; c0 < cells; c0 += cellChunk) {
+      const Eigen::Index len = std::min(cellChunk, cells - c0);
+      for (int i = 0; i < a.count; ++i) {
+        const float* xi = X.col(a.first + i).data() + c0;
+        const int gi = rowFrame + a.first + i;
+        for (int j = 0; j < b.count; ++j) {
+          const int gj = columnFrame + b.first + j;
+          if (gj <= gi) continue;
+          const float* xj = Y.col(b.first + j).data() + c0;
+          if (isMax) {
+            float m = 0.0f;
 #pragma omp simd reduction(max : m)
-                for (Eigen::Index c = 0; c < len; ++c) m = std::max(m, std::fabs(xi[c] - xj[c]));
-                acc(i, j) = std::max(acc(i, j), double(m));
-              } else {
-                double sum = 0.0;
+            for (Eigen::Index c = 0; c < len; ++c) m = std::max(m, std::fabs(xi[c] - xj[c]));
+            acc(i, j) = std::max(acc(i, j), double(m));
+          } else {
+            double sum = 0.0;
 #pragma omp simd reduction(+ : sum)
-                for (Eigen::Index c = 0; c < len; ++c)
-                  sum += w[c0 + c] * std::fabs(double(xi[c]) - double(xj[c]));
-                acc(i, j) += sum;
-              }
-            }
+            for (Eigen::Index c = 0; c < len; ++c)
+              sum += w[c0 + c] * std::fabs(double(xi[c]) - double(xj[c]));
+            acc(i, j) += sum;
           }
         }
-        for (int i = 0; i < a.count; ++i)
-          for (int j = 0; j < b.count; ++j) {
-            const int gi = blocks[p].first + a.first + i, gj = blocks[q].first + b.first + j;
-            if (gj > gi) D(gi, gj) = D(gj, gi) = acc(i, j);
-          }
-        stop.advance(kEntryWork * a.count * b.count);
       }
-      stop.throwIfStopped();
     }
-  }
+    for (int i = 0; i < a.count; ++i)
+      for (int j = 0; j < b.count; ++j) {
+        const int gi = rowFrame + a.first + i, gj = columnFrame + b.first + j;
+        if (gj > gi) D(gi, gj) = D(gj, gi) = acc(i, j);
+      }
+  };
+  forEachTilePair<MatrixXfC>(n, framesPerBlock, tileFrames, cells, load, distanceTile, stop);
   return D;
 }
 
@@ -331,8 +338,8 @@ Eigen::MatrixXd distanceMatrix(const ScalarSeries& series, RecurrenceNorm norm,
       for (std::size_t q = p; q < b.size(); ++q) {
         if (q != p) work += b[q].count;
         const auto tp = tiles(0, b[p].count, tileFrames), tq = tiles(0, b[q].count, tileFrames);
-        for (std::size_t i = 0; i < tp.size(); ++i)
-          for (std::size_t j = q == p ? i : 0; j < tq.size(); ++j) work += kEntryWork * tp[i].count * tq[j].count;
+        for (const auto& [i, j] : tilePairs(tp.size(), tq.size(), q == p))
+          work += kEntryWork * tp[std::size_t(i)].count * tq[std::size_t(j)].count;
       }
     }
   }

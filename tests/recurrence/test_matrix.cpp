@@ -141,6 +141,51 @@ TEST(RecurrenceMatrix, L1AndMaxNormsEqualNaiveLoops) {
   }
 }
 
+// Every tile pair of every block pair lands where it belongs, for every norm, arithmetic, blocking and
+// tiling, in the parallel loop too: on frames of quarter-integer values with perfect-square weights
+// every sum is exact in float and double, so D equals the naive sums bit for bit.
+TEST(RecurrenceMatrix, ExactDataGiveTheNaiveDistancesBitForBit) {
+  const int frames = 100;
+  const std::size_t cells = 1100;  // 100 x 100 x 1100 > 1e7: the tile loops run in parallel
+  ScalarSeries s;
+  s.frames = frames;
+  for (std::size_t c = 0; c < cells; ++c) s.weights.push_back(double((c % 3 + 1) * (c % 3 + 1)));  // 1, 4, 9
+  std::vector<float> values(std::size_t(frames) * cells);  // frame-major, in [-1, 1]
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const std::size_t frame = k / cells, c = k % cells;
+    values[k] = float(int((7 * frame + 3 * c + frame * c) % 9) - 4) * 0.25f;
+  }
+  auto value = [&](int frame, std::size_t c) { return values[std::size_t(frame) * cells + c]; };
+  s.fetch = [&](int frame, float* out) {
+    for (std::size_t c = 0; c < cells; ++c) out[c] = value(frame, c);
+  };
+  for (RecurrenceNorm norm : {RecurrenceNorm::L2, RecurrenceNorm::L1, RecurrenceNorm::Max}) {
+    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(frames, frames);
+    for (int i = 0; i < frames; ++i)
+      for (int j = 0; j < frames; ++j)
+        for (std::size_t c = 0; c < cells; ++c) {
+          const double diff = double(value(i, c)) - double(value(j, c));
+          if (norm == RecurrenceNorm::L2) expected(i, j) += s.weights[c] * diff * diff;
+          else if (norm == RecurrenceNorm::L1) expected(i, j) += s.weights[c] * std::abs(diff);
+          else expected(i, j) = std::max(expected(i, j), std::abs(diff));
+        }
+    for (GramPrecision gram : {GramPrecision::Double, GramPrecision::FloatChunked}) {
+      if (norm != RecurrenceNorm::L2 && gram != GramPrecision::Double) continue;  // Gram form only
+      const bool doubles = norm == RecurrenceNorm::L2 && gram == GramPrecision::Double;
+      // One block, or blocks of 15 double (30 float) frames.
+      for (std::int64_t budget : {std::int64_t(1) << 30, std::int64_t(cells * 4 * 2 * 30)})
+        for (int tile : {1, 7, 16}) {
+          int blocks = 0;
+          std::int64_t clamped = -1;
+          const Eigen::MatrixXd D = distanceMatrix(s, norm, budget, tile, &blocks, &clamped, gram);
+          EXPECT_TRUE(D == expected) << toString(norm) << " budget " << budget << " tile " << tile;
+          EXPECT_EQ(blocks, budget == std::int64_t(1) << 30 ? 1 : doubles ? 7 : 4);
+          EXPECT_EQ(clamped, 0);
+        }
+    }
+  }
+}
+
 TEST(RecurrenceMatrix, VelocityComponentField) {
   auto db = wavyDb(20);
   for (const char* field : {"u_p.y", "u_g.z"}) {

@@ -47,6 +47,25 @@ void expectInRange(const RecurrencePath& p, int n) {
   }
 }
 
+// Symmetric, unit diagonal, every entry a multiple of 1/16: exact in float and free of libm, so a path
+// drawn on it is the same on every platform.
+Eigen::MatrixXf dyadicR(int n) {
+  Eigen::MatrixXf R(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) R(i, j) = i == j ? 1.0f : float((7 * (i + j) + 3 * i * j) % 17) / 16.0f;
+  return R;
+}
+
+// FNV-1a over the frame indices: pins a whole path in one number.
+std::uint64_t pathHash(const RecurrencePath& p) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (int f : p.frames) {
+    h ^= std::uint64_t(std::uint32_t(f));
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
 }  // namespace
 
 TEST(PaperPath, JumpsLandOnTheSamePhaseOfAPeriodicField) {
@@ -121,6 +140,54 @@ TEST(PaperPath, GoldenValuesOfTheRandomMapping) {
   std::mt19937_64 check(1);
   for (int k = 0; k < 6; ++k) EXPECT_EQ(draws[std::size_t(k)], 10 + std::int64_t(check() % 31));
   EXPECT_EQ(draws[0], 10 + std::int64_t(2469588189546311528ull % 31));
+}
+
+// The paths of fixed seeds, recorded once from this implementation: the first frames and a hash of
+// 5000 steps. Platform-independent (integer draws, PathRandom.hpp; R exact, dyadicR); a change here
+// changes every seeded run.
+TEST(SeededPaths, FixedSeedsGiveRecordedPaths) {
+  struct Case {
+    const char* type;
+    int frames;
+    double minFraction, maxFraction;
+    int minSequenceFrames, window;
+    bool identity;  // R = I: the Markov rule's uniform fallback
+    std::uint64_t seed;
+    std::vector<int> prefix;
+    std::uint64_t hash;
+  };
+  const std::vector<Case> cases{
+      {"paper", 60, 0.05, 0.2, 1, 0, false, 42,
+       {11, 12, 13, 14, 15, 16, 17, 47, 48, 49, 14, 15, 16, 17, 18, 41, 42, 43, 44, 17,
+        18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 34, 35, 36, 37, 38, 39, 40, 41, 42, 3},
+       1353250851929529080ull},
+      // Sequences as long as the database: every one ends at the last frame (forced jump).
+      {"paper", 7, 0.9, 1.0, 1, 0, false, 5,
+       {4, 5, 6, 2, 3, 4, 5, 6, 2, 3, 4, 5, 6, 2, 3, 4, 5, 6, 2, 3},
+       2187295881536834069ull},
+      {"markov", 60, 0.05, 0.2, 3, 5, false, 77,
+       {41, 42, 43, 44, 45, 30, 31, 32, 33, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 44,
+        34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53},
+       18022685333015640347ull},
+      {"markov", 30, 0.05, 0.2, 1, 2, true, 3,
+       {14, 15, 16, 17, 18, 19, 1, 2, 3, 4, 5, 6, 22, 23, 24, 18, 19, 20, 21, 22,
+        23, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 7, 8, 25, 15, 16, 17, 18, 19, 24},
+       7912976070391007322ull},
+  };
+  for (const Case& c : cases) {
+    PathSpec spec;
+    spec.min_sequence_fraction = c.minFraction;
+    spec.max_sequence_fraction = c.maxFraction;
+    spec.min_sequence_frames = c.minSequenceFrames;
+    spec.correlation_window = c.window;
+    const Eigen::MatrixXf R =
+        c.identity ? Eigen::MatrixXf(Eigen::MatrixXf::Identity(c.frames, c.frames)) : dyadicR(c.frames);
+    const RecurrencePath p = PathGeneratorRegistry::create(c.type, spec)->generate(R, 5000, c.seed);
+    ASSERT_EQ(p.frames.size(), 5000u);
+    EXPECT_EQ(std::vector<int>(p.frames.begin(), p.frames.begin() + std::ptrdiff_t(c.prefix.size())), c.prefix)
+        << c.type << " seed " << c.seed;
+    EXPECT_EQ(pathHash(p), c.hash) << c.type << " seed " << c.seed;
+  }
 }
 
 TEST(PaperPath, NeverRunsPastTheLastFrame) {

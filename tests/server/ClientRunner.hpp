@@ -6,12 +6,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "ChildProcess.hpp"
 #include "ServerFixture.hpp"
 
 namespace rcfd::test {
@@ -40,15 +42,17 @@ struct RunningClient {
   }
 };
 
-/// Starts build/rcfd with arguments and extra environment.
-inline RunningClient startClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
+/// Starts build/rcfd with arguments and extra environment. A client still running after `hangLimit`
+/// is killed (SIGALRM), so that one that hangs fails its test instead of hanging the suite; 0: no limit.
+inline RunningClient startClient(std::vector<std::string> args, const std::vector<std::string>& env = {},
+                                 std::chrono::seconds hangLimit = std::chrono::seconds(60)) {
   const auto bin = (binaryDir() / "rcfd").string();
   args.insert(args.begin(), bin);
   RunningClient running;
   const auto outPath = running.outPath(), errPath = running.errPath();
   const pid_t pid = ::fork();
   if (pid == 0) {
-    ::alarm(60);  // a client that hangs is killed (and its test fails) instead of hanging the suite
+    ::alarm(static_cast<unsigned>(hangLimit.count()));
     ::unsetenv("RCFD_SERVER");
     ::unsetenv("RCFD_TOKEN");
     ::unsetenv("RCFD_CACERT");
@@ -57,19 +61,16 @@ inline RunningClient startClient(std::vector<std::string> args, const std::vecto
     const int err = ::open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     ::dup2(out, 1);
     ::dup2(err, 2);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
+    execOrExit(std::move(args));
   }
   running.pid = pid;
   return running;
 }
 
 /// Runs build/rcfd with arguments and extra environment; captures stdout and stderr.
-inline Run runClient(std::vector<std::string> args, const std::vector<std::string>& env = {}) {
-  return startClient(std::move(args), env).finish();
+inline Run runClient(std::vector<std::string> args, const std::vector<std::string>& env = {},
+                     std::chrono::seconds hangLimit = std::chrono::seconds(60)) {
+  return startClient(std::move(args), env, hangLimit).finish();
 }
 
 inline std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }

@@ -2,10 +2,6 @@
 // Test helpers: start a real rcfd-server (from RCFD_BINARY_DIR) on 127.0.0.1:0 with a temporary data
 // directory, and talk to it over real HTTP (Boost.Beast, one connection per request).
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <boost/asio/connect.hpp>
@@ -22,6 +18,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "ChildProcess.hpp"
 
 namespace rcfd::test {
 
@@ -98,105 +96,67 @@ inline Reply httpRequest(unsigned short port, boost::beast::http::verb method, c
   return replyOf(parser.get());
 }
 
-/// A running rcfd-server child process.
-class ServerProcess {
+/// A running rcfd-server child process with its own data directory and token, and HTTP requests to it.
+class ServerProcess : public ServerChild {
  public:
   /// fileLimit > 0: the server runs with at most that many open descriptors (RLIMIT_NOFILE). `listen`
   /// is its address (port 0: any free port; a restart passes the port of the server it replaces).
   /// An empty `token` passes no --token-file (for a server given --users-file in `extraArgs`); get()
-  /// and post() then send no token.
+  /// and post() then send no token. Throws std::runtime_error, with the server's stderr, when it does
+  /// not start listening.
   ServerProcess(const std::filesystem::path& dataDir, std::string token,
                 std::vector<std::string> extraArgs = {"--workers", "0"}, int fileLimit = 0,
                 const std::string& listen = "127.0.0.1:0")
-      : dataDir_(dataDir), token_(std::move(token)) {
-    const auto binary = binaryDir() / "rcfd-server";
-    std::vector<std::string> args = {binary.string(), "--data-dir", dataDir.string(), "--listen", listen};
-    if (!token_.empty()) {
-      const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
-      std::ofstream(tokenFile) << token_ << "\n";
-      args.insert(args.end(), {"--token-file", tokenFile.string()});
-    }
-    args.insert(args.end(), extraArgs.begin(), extraArgs.end());
-    int out[2];
-    if (::pipe(out) != 0) throw std::runtime_error("pipe");
-    stderrPath_ = dataDir.parent_path() / (dataDir.filename().string() + ".stderr");
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      if (fileLimit > 0) {
-        const rlimit limit{rlim_t(fileLimit), rlim_t(fileLimit)};
-        ::setrlimit(RLIMIT_NOFILE, &limit);
-      }
-      ::dup2(out[1], 1);
-      const int err = ::open(stderrPath_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      ::dup2(err, 2);
-      ::close(out[0]);
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    ::close(out[1]);
-    // First stdout line: "listening on http://127.0.0.1:PORT" (https:// with --tls-cert).
-    std::string line;
-    char c;
-    while (::read(out[0], &c, 1) == 1 && c != '\n') line.push_back(c);
-    ::close(out[0]);
-    firstLine_ = line;
-    const auto colon = line.rfind(':');
-    tls_ = line.rfind("listening on https://", 0) == 0;
-    if ((!tls_ && line.rfind("listening on http://", 0) != 0) || colon == std::string::npos) {
+      : ServerChild(command(dataDir, token, std::move(extraArgs), fileLimit, listen)),
+        stderrPath_(stderrPathOf(dataDir)),
+        token_(std::move(token)) {
+    if (!listening()) {
       // A server that refused to start has exited (one that printed something else is stopped): reap
       // it; its last words are in its stderr file.
-      ::kill(pid_, SIGKILL);
-      int status = 0;
-      ::waitpid(pid_, &status, 0);
-      pid_ = -1;
-      throw std::runtime_error("rcfd-server did not start: \"" + line + "\"; stderr: " + stderrText());
+      stop(SIGKILL);
+      throw std::runtime_error("rcfd-server did not start: \"" + firstLine() + "\"; stderr: " + stderrText());
     }
-    port_ = static_cast<unsigned short>(std::stoi(line.substr(colon + 1)));
   }
-  ~ServerProcess() {
-    if (pid_ > 0) stop(SIGTERM);
-  }
-  ServerProcess(const ServerProcess&) = delete;
-  ServerProcess& operator=(const ServerProcess&) = delete;
 
-  /// Sends `sig` and waits; returns the wait status.
-  int stop(int sig) {
-    int status = 0;
-    if (pid_ <= 0) return status;
-    ::kill(pid_, sig);
-    ::waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return status;
-  }
-  bool alive() const { return pid_ > 0 && ::kill(pid_, 0) == 0; }
-
-  unsigned short port() const { return port_; }
-  pid_t pid() const { return pid_; }
   const std::string& token() const { return token_; }
-  const std::string& firstLine() const { return firstLine_; }
-  std::string url() const { return (tls_ ? "https" : "http") + std::string("://127.0.0.1:") + std::to_string(port_); }
+  std::string url() const { return (tls() ? "https" : "http") + std::string("://127.0.0.1:") + std::to_string(port()); }
   std::string stderrText() const {
     std::ifstream in(stderrPath_);
     return std::string(std::istreambuf_iterator<char>(in), {});
   }
 
   Reply get(const std::string& target) const {
-    return httpRequest(port_, boost::beast::http::verb::get, target, token_);
+    return httpRequest(port(), boost::beast::http::verb::get, target, token_);
   }
   Reply post(const std::string& target, const std::string& body,
              const std::map<std::string, std::string>& headers = {}) const {
-    return httpRequest(port_, boost::beast::http::verb::post, target, token_, body, headers);
+    return httpRequest(port(), boost::beast::http::verb::post, target, token_, body, headers);
   }
 
  private:
-  std::filesystem::path dataDir_, stderrPath_;
-  std::string token_, firstLine_;
-  pid_t pid_ = -1;
-  unsigned short port_ = 0;
-  bool tls_ = false;
+  /// The server's stderr, beside its data directory (so it outlives the server).
+  static std::filesystem::path stderrPathOf(const std::filesystem::path& dataDir) {
+    return dataDir.parent_path() / (dataDir.filename().string() + ".stderr");
+  }
+  /// The command line for the constructor's arguments; writes the token file it names.
+  static ServerCommand command(const std::filesystem::path& dataDir, const std::string& token,
+                               std::vector<std::string> extraArgs, int fileLimit, const std::string& listen) {
+    std::vector<std::string> args = {(binaryDir() / "rcfd-server").string(), "--data-dir", dataDir.string(),
+                                     "--listen", listen};
+    if (!token.empty()) {
+      const auto tokenFile = dataDir.parent_path() / (dataDir.filename().string() + ".token");
+      std::ofstream(tokenFile) << token << "\n";
+      args.insert(args.end(), {"--token-file", tokenFile.string()});
+    }
+    args.insert(args.end(), extraArgs.begin(), extraArgs.end());
+    ServerCommand command(std::move(args));
+    command.stderrFile = stderrPathOf(dataDir);
+    command.fileLimit = fileLimit;
+    return command;
+  }
+
+  std::filesystem::path stderrPath_;
+  std::string token_;
 };
 
 /// The scene of examples/quick.json (a scene, or a job file holding one inline or via scene_file).

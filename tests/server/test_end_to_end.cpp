@@ -10,6 +10,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "ClientRunner.hpp"
 #include "ServerFixture.hpp"
 #include "SmallDatabase.hpp"
 
@@ -62,36 +63,11 @@ Histogram readCsv(const std::filesystem::path& path) {
   return h;
 }
 
-struct Run {
-  int code = -1;
-  std::string out, err;
-};
-
+/// Runs the client against `server`, without ClientRunner's hang limit: `submit --wait` lasts as long
+/// as a real solve, which on a loaded machine may take longer.
 Run client(const ServerProcess& server, std::vector<std::string> args) {
-  args.insert(args.begin(), {(binaryDir() / "rcfd").string(), "--server", server.url(), "--token",
-                             server.token()});
-  TempDir capture;
-  const auto outPath = capture.path() / "out", errPath = capture.path() / "err";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int out = ::open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err = ::open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(out, 1);
-    ::dup2(err, 2);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  Run r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream o(outPath), e(errPath);
-  r.out.assign(std::istreambuf_iterator<char>(o), {});
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
+  args.insert(args.begin(), {"--server", server.url(), "--token", server.token()});
+  return runClient(std::move(args), {}, std::chrono::seconds(0));
 }
 
 /// Polls until the job's state satisfies `done` (or the timeout passes); returns the last resource.

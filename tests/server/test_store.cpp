@@ -85,26 +85,14 @@ TEST(Store, GeneratesATokenWhenNoneIsConfigured) {
   const auto data = tmp.path() / "data";
   std::filesystem::create_directories(data);
   // Start without --token-file and without RCFD_TOKEN: the server writes DIR/token.
-  int out[2];
-  ASSERT_EQ(::pipe(out), 0);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::unsetenv("RCFD_TOKEN");
-    ::dup2(out[1], 1);
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    ::dup2(devnull, 2);
-    const auto bin = (binaryDir() / "rcfd-server").string();
-    ::execl(bin.c_str(), bin.c_str(), "--data-dir", data.c_str(), "--listen", "127.0.0.1:0",
-            "--workers", "0", static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  ::close(out[1]);
-  std::string line;
-  char c;
-  while (::read(out[0], &c, 1) == 1 && c != '\n') line.push_back(c);
-  ::close(out[0]);
+  ServerCommand command({(binaryDir() / "rcfd-server").string(), "--data-dir", data.string(), "--listen",
+                         "127.0.0.1:0", "--workers", "0"});
+  command.stderrFile = "/dev/null";
+  command.unsetEnvironment = {"RCFD_TOKEN"};
+  ServerChild server(std::move(command));
+  const std::string& line = server.firstLine();
   ASSERT_EQ(line.rfind("listening on http://127.0.0.1:", 0), 0u) << line;
-  const auto port = static_cast<unsigned short>(std::stoi(line.substr(line.rfind(':') + 1)));
+  const auto port = server.port();
   std::ifstream in(data / "token");
   std::string token;
   in >> token;
@@ -113,9 +101,7 @@ TEST(Store, GeneratesATokenWhenNoneIsConfigured) {
             std::filesystem::perms::none);
   EXPECT_EQ(httpRequest(port, boost::beast::http::verb::get, "/v1/jobs", token).status, 200);
   EXPECT_EQ(httpRequest(port, boost::beast::http::verb::get, "/v1/jobs", "x").status, 401);
-  ::kill(pid, SIGTERM);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+  const int status = server.stop(SIGTERM);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 
