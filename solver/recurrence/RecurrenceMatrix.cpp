@@ -152,8 +152,9 @@ std::vector<std::pair<int, int>> tilePairs(std::size_t rowTiles, std::size_t col
 // per frame. Each block pair is split into tiles of `tileFrames` frames, and
 // `tilePair(X, Y, a, b, rowFrame, columnFrame)` computes the entries of tile a of X against tile b of
 // Y, whose first columns are frames rowFrame and columnFrame; tiles below the diagonal are skipped.
-// Tiles are independent and run in parallel, each on one thread (Eigen's GEMM does not nest inside an
-// active omp parallel region), which keeps both cores busy even when other processes share them. A
+// Tiles are independent and run in parallel, each on one thread (Eigen never splits a product itself:
+// EIGEN_DONT_PARALLELIZE, so the sums do not depend on the thread count), which keeps both cores busy
+// even when other processes share them. A
 // stop request is polled before every tile and thrown after the parallel loop (StopPoll).
 template <class Matrix, class Load, class TilePair>
 void forEachTilePair(int frames, int framesPerBlock, int tileFrames, Eigen::Index cells, Load&& load,

@@ -84,6 +84,23 @@ TEST(RecurrenceMatrix, AutoFallsBackToDoubleWhenTheSpotCheckFails) {
   EXPECT_EQ(automatic.R, exact.R);
 }
 
+TEST(RecurrenceMatrix, OneAndTwoThreadsGiveTheSameMatrixBitForBit) {
+  // One tile holding every frame: the tile loop runs on one thread, and its GEMMs are large enough for
+  // a parallelising BLAS to split them, which would change the order of the sums with the threads.
+  auto db = wavyDb(96, 20, 16, 8);
+  for (GramPrecision gram : {GramPrecision::Double, GramPrecision::FloatChunked}) {
+    RecurrenceOptions o;
+    o.gram = gram;
+    o.tileFrames = 1000;
+    omp_set_num_threads(1);
+    const RecurrenceMatrix one = computeRecurrenceMatrix(*db, o);
+    omp_set_num_threads(2);
+    const RecurrenceMatrix two = computeRecurrenceMatrix(*db, o);
+    ASSERT_EQ(one.R.size(), two.R.size());
+    EXPECT_TRUE(std::equal(one.R.data(), one.R.data() + one.R.size(), two.R.data()));
+  }
+}
+
 TEST(RecurrenceMatrix, BlockedOverFramesEqualsUnblocked) {
   auto db = wavyDb(37);
   const Eigen::MatrixXd expected = naiveR(naiveDistances(*db, "alpha_p", RecurrenceNorm::L2));

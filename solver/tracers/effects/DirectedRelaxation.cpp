@@ -204,9 +204,8 @@ class DirectedRelaxationEffect final : public TracerEffect {
   std::vector<std::int32_t> row_;   ///< per cell: its row among the open cells, or -1
   std::vector<std::int32_t> open_;  ///< per row: its cell
   std::vector<std::int32_t> upperNeighbour_;  ///< per row and axis: the row of the open cell above, or -1
-  // The self-adjoint product of the lower triangle runs on one thread. With Lower|Upper Eigen takes a
-  // row-major product, which opens an OpenMP region per iteration: on a loaded machine its barriers
-  // cost several times the small solve.
+  // The self-adjoint product of the lower triangle, on one thread (Eigen does not parallelise in
+  // rcfd: EIGEN_DONT_PARALLELIZE): a parallel region per iteration would cost more than the small solve.
   Eigen::SparseMatrix<double> matrix_;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower> solver_;
   Eigen::VectorXd excess_, w_;
