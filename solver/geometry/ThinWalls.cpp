@@ -115,8 +115,8 @@ bool plateSeparates(const Apparatus& apparatus, const CartesianGrid& grid, const
   const double to = from + grid.spacing[across];
   const double slack = kSnap * grid.spacing[across];
   for (const auto& hole : apparatus.holes()) {
-    Eigen::Vector2d lo = hole[0], hi = hole[0];
-    for (const auto& v : hole) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    Eigen::Vector2d lo, hi;
+    bounds(hole, lo, hi);
     if (plane >= lo[d] && plane <= hi[d] && from >= lo[across] - slack && to <= hi[across] + slack) return true;
   }
   return false;

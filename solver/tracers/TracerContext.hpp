@@ -39,9 +39,8 @@ struct TracerContext {
   std::uint64_t seed = 1;
 
   std::vector<double> openVolume;  ///< open volume of each cell [m3]
-  /// Per cell, the plate faces interpolation does not cross (plateFacesAbove,
-  /// geometry/ThinWalls.hpp); empty without
-  /// plates thinner than a cell, or where the context's points may lie between a plate and its face.
+  /// Per cell, the plate faces trilinear sampling does not cross (plateFacesAbove,
+  /// geometry/ThinWalls.hpp); empty without plates. Set by TracerSimulation.
   std::vector<std::uint8_t> plateFaces;
   const std::uint8_t* plateFacesOrNull() const { return plateFaces.empty() ? nullptr : plateFaces.data(); }
   double dt = 0.0;                 ///< tracer time step [s]
