@@ -237,15 +237,20 @@ class LangevinVelocityEffect final : public TracerEffect {
     }
   }
 
-  /// d f / dx_d at cell c from its open neighbours along d (one-sided at walls, 0 without any).
+  /// d f / dx_d at cell c from its open neighbours along d (one-sided at walls and plates, 0 without
+  /// any). A neighbour across a plate is not one: its particles never meet this cell's, and a gradient
+  /// taken across the plate would drive the tracers beside it against the plate.
   static double centralDifference(const TracerContext& ctx, const std::vector<double>& f, std::size_t c, std::size_t d) {
     const CartesianGrid& grid = ctx.grid;
     const auto ijk = grid.cellIjk(std::int64_t(c));
+    const std::uint8_t* plates = ctx.plateFacesOrNull();
+    const std::uint8_t plateBit = d == 0 ? kPlateAboveX : d == 1 ? kPlateAboveY : 0;
     auto neighbour = [&](int side) -> std::int64_t {
       auto nb = ijk;
       nb[d] += side;
       if (nb[d] < 0 || nb[d] >= grid.shape[d]) return -1;
       const std::int64_t o = grid.flatIndex(nb[0], nb[1], nb[2]);
+      if (plates && plateBit && (plates[side > 0 ? c : std::size_t(o)] & plateBit)) return -1;
       return ctx.openVolume[std::size_t(o)] > 0.0 ? o : -1;
     };
     const std::int64_t lo = neighbour(-1), hi = neighbour(1);
