@@ -3,11 +3,10 @@
 // variance, the tracers' mean fluctuation over a step has the variance and lag-one correlation of the
 // integrated OU process, T the kinetic-theory time between collisions in a dense bed and
 // rcfd.langevin_time in a dilute one, and where T is far below the step the tracers spread with the
-// diffusivity sigma^2 T; where alpha_P^rec and the variance vary across the box, the drift
-// keeps the tracers distributed as alpha_P^rec and takes no gradient through a draft plate; the count is
-// kept, results are bit-identical for 1 and
-// 2 threads and across a resume, a database without the velocity spread leaves the tracers as without
-// the effect, and a scene without the effect allocates nothing for it. The normal numbers come from a
+// diffusivity sigma^2 T; where alpha_P^rec and the variance vary across the box, the drift keeps the
+// tracers distributed as alpha_P^rec, and it takes no gradient through a draft plate; the count is kept,
+// results are bit-identical for 1 and 2 threads and across a resume, a database without the velocity
+// spread leaves the tracers as without the effect, and a scene without the effect allocates nothing for it. The normal numbers come from a
 // table of quantiles (NormalTable).
 #include <gtest/gtest.h>
 #include <omp.h>
