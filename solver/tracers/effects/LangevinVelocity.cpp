@@ -100,6 +100,7 @@ class LangevinVelocityEffect final : public TracerEffect {
     float* out[3] = {ctx.streamVelocity[0].data(), ctx.streamVelocity[1].data(), ctx.streamVelocity[2].data()};
     float* u[3] = {fluctuation_[0].data(), fluctuation_[1].data(), fluctuation_[2].data()};
     const float* coefficients = coefficients_.data();
+    const double* alpha = alpha_.data();
     const NormalTable& normals = NormalTable::instance();
     const bool owner = owner_;
 #pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
@@ -126,7 +127,12 @@ class LangevinVelocityEffect final : public TracerEffect {
         next[d] = mean + at[kDecay] * deviation + sigma * at[kKick] * xi1[d];
         step[d] = mean + at[kCarry] * deviation + sigma * (at[kShared] * xi1[d] + at[kOwn] * xi2[d]);
       }
-      reflectAtWalls(ctx.apparatus, Eigen::Vector3d(position[0][i], position[1][i], position[2][i]), ctx.dt, step, next);
+      const Eigen::Vector3d here(position[0][i], position[1][i], position[2][i]);
+      reflectAtWalls(ctx.apparatus, here, ctx.dt, step, next);
+      // The fluctuation is the particles' own: it does not carry a tracer where the frame holds none (the
+      // bed's free surface, the rim of a jet). Reflected there, as at a wall, it keeps the tracers within
+      // the particle phase, whose edge the drift alone, taken between cell centres, does not hold.
+      if (alpha[std::size_t(ctx.grid.flatIndexOf(here + ctx.dt * step))] <= 0.0) step = -step, next = -next;
       for (int d = 0; d < 3; ++d) {
         u[d][i] = float(next[d]);
         out[d][i] = owner ? float(step[d]) : out[d][i] + float(step[d]);
