@@ -195,9 +195,12 @@ std::vector<Violation> checkSceneSemantics(const Scene& s, const json& document)
 
   static const char* axes[] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
-    if (s.grid.cell_size[i] >= extent[i]) {
+    // One cell across an extent is a grid (the pseudo-2D cases other codes write); a cell larger than
+    // the apparatus is not: the grid would silently shrink it to the extent.
+    if (s.grid.cell_size[i] > extent[i] * (1.0 + 1e-9)) {
       out.push_back({"/grid/cell_size", "cell size " + num(s.grid.cell_size[i]) + " m along " + axes[i] +
-                                            " is not smaller than the apparatus extent " + num(extent[i]) + " m"});
+                                            " is larger than the apparatus extent " + num(extent[i]) +
+                                            " m (allowed: at most the extent, one cell across it)"});
     }
   }
   const double parcel = s.dem.coarse_graining * s.particles.diameter;

@@ -23,7 +23,7 @@ struct BadScene {
 const BadScene kBadScenes[] = {
     {"array_instead_of_object.json", "", "got an array"},
     {"box_keys_on_prismatic.json", "/apparatus/size", "unknown key \"size\" for type \"prismatic_spouted_bed\""},
-    {"cell_size_too_big.json", "/grid/cell_size", "not smaller than the apparatus extent"},
+    {"cell_size_too_big.json", "/grid/cell_size", "is larger than the apparatus extent"},
     {"cell_size_two_items.json", "/grid/cell_size", "(minItems)"},
     {"cone_angle_95.json", "/spray/cone_half_angle_deg", "95 is not < 90 (exclusiveMaximum)"},
     {"coupling_interval_zero.json", "/dem/coupling_interval", "0 is not >= 1 (minimum)"},

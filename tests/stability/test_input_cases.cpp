@@ -102,6 +102,16 @@ TEST(InputCases, AOneCellDeepGridRunsEveryJobKind) {
   runEveryKind("one-deep", scene);
 }
 
+// One cell deep whose cell is the whole depth (10 mm), as pseudo-2D cases of other codes are written.
+TEST(InputCases, ACellAsDeepAsTheApparatusRunsEveryJobKind) {
+  json scene = thinPrism();
+  scene["grid"]["cell_size"] = {0.005, 0.005, 0.01};
+  const auto grid = sceneGrid(scene).grid;
+  ASSERT_EQ(grid.shape[2], 1);
+  EXPECT_DOUBLE_EQ(grid.spacing.z(), 0.01);
+  runEveryKind("cell-as-deep", scene);
+}
+
 // One cell wide: a box 1 cm across with 8 mm cells (a box has no gas inlet: the DEM alone); parcels
 // of 3 mm.
 TEST(InputCases, AOneCellWideGridRunsEveryJobKind) {
