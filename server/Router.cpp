@@ -1,6 +1,7 @@
 #include "Router.hpp"
 
 #include "Ids.hpp"
+#include "OpenApi.hpp"
 #include "Problem.hpp"
 #include "WorkerPool.hpp"
 #include "scene/SceneLoader.hpp"
@@ -105,6 +106,11 @@ Response Router::route(const Request& req, const Target& target, const std::opti
   // Only health is public (handle() answered 401 for anything else without a caller).
   if (!caller) return unauthorized(target.path);
   const Caller& who = *caller;
+  if (s.size() == 2 && s[1] == "openapi.json") {
+    if (!get) return methodNotAllowed(target, "GET");
+    static const std::string document = jsonText(openApiDocument(kVersion));
+    return textResponse(http::status::ok, document, "application/json");
+  }
   if (s.size() == 3 && s[1] == "schemas") {
     if (!get) return methodNotAllowed(target, "GET");
     try {

@@ -277,6 +277,7 @@ class RequestGenerator {
       case Route::health: return "/v1/health";
       case Route::healthSlash: return "/v1/health/";
       case Route::schema:
+        if (chance(0.2)) return pick<std::string>({"/v1/openapi.json", "/v1/openapi.json/x", "/v1/openapi"});
         return "/v1/schemas/" + pick<std::string>({"scene", "job", "job.schema.json", "nope", "", "../job", "%73cene"});
       case Route::metrics: return "/metrics";
       case Route::root: return "/";

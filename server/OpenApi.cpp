@@ -1,0 +1,117 @@
+#include "OpenApi.hpp"
+
+#include <regex>
+
+#include "scene/SceneLoader.hpp"
+
+namespace rcfd::server {
+
+const std::vector<RouteSpec>& routeSpecs() {
+  static const std::vector<RouteSpec> routes = {
+      {"post", "/v1/jobs", "submitJob", "Submit a job (202: queued)", "application/json", "job"},
+      {"get", "/v1/jobs", "listJobs", "List jobs, newest first, a page at a time", "application/json"},
+      {"get", "/v1/jobs/{id}", "getJob", "A job's state, progress and summary", "application/json"},
+      {"get", "/v1/jobs/{id}/events", "listJobEvents", "A job's state transitions", "application/json"},
+      {"post", "/v1/jobs/{id}:cancel", "cancelJob", "Cancel a queued or running job", "application/json"},
+      {"post", "/v1/jobs/{id}:retry", "retryJob", "Run a failed or cancelled job again", "application/json"},
+      {"get", "/v1/jobs/{id}/result", "getJobResult", "A finished job's summary.json", "application/json"},
+      {"get", "/v1/jobs/{id}/coverage", "getJobCoverage", "A spray job's coverage (format json, csv or h5)",
+       "application/json"},
+      {"get", "/v1/jobs/{id}/artifacts/{name}", "getJobArtifact", "A file the job wrote", "application/octet-stream"},
+      {"post", "/v1/databases", "uploadDatabase", "Upload a field database (HDF5; 201: stored)", "application/json"},
+      {"get", "/v1/databases/{id}", "getDatabase", "An uploaded database's record", "application/json"},
+      {"get", "/v1/schemas/{name}", "getSchema", "The JSON Schema of scenes (scene) or jobs (job)",
+       "application/schema+json"},
+      {"get", "/v1/openapi.json", "getOpenApi", "This document", "application/json"},
+      {"get", "/v1/health", "getHealth", "Liveness, version and workers (no token)", "application/json", nullptr,
+       false},
+      {"get", "/metrics", "getMetrics", "Prometheus metrics", "text/plain"},
+  };
+  return routes;
+}
+
+namespace {
+
+using nlohmann::json;
+
+/// The path parameters of a template: the names between braces.
+std::vector<std::string> pathParameters(const std::string& path) {
+  std::vector<std::string> names;
+  static const std::regex brace("\\{([a-z_]+)\\}");
+  for (auto it = std::sregex_iterator(path.begin(), path.end(), brace); it != std::sregex_iterator(); ++it)
+    names.push_back((*it)[1]);
+  return names;
+}
+
+/// An embedded JSON Schema as an OpenAPI 3.1 component (OpenAPI 3.1 schemas are JSON Schema 2020-12):
+/// the draft-07 `definitions` of the file become `$defs`, and its references (to them and to the scene
+/// schema's file) follow.
+json component(const std::string& name) {
+  std::string text = schemaText(name);
+  static const std::regex definitions("#/definitions/");
+  text = std::regex_replace(text, definitions, "#/components/schemas/" + name + "/$defs/");
+  static const std::regex sceneFile("\"scene\\.schema\\.json\"");
+  text = std::regex_replace(text, sceneFile, "\"#/components/schemas/scene\"");
+  json schema = json::parse(text);
+  if (schema.contains("definitions")) {
+    schema["$defs"] = std::move(schema["definitions"]);
+    schema.erase("definitions");
+  }
+  schema.erase("$schema");
+  schema.erase("$id");
+  return schema;
+}
+
+}  // namespace
+
+json openApiDocument(const std::string& version) {
+  json doc;
+  doc["openapi"] = "3.1.0";
+  doc["info"] = {{"title", "rcfd job service"},
+                 {"version", version},
+                 {"summary", "Recurrence CFD of spray coating in spouted beds: database, calibration and spray jobs"},
+                 {"description", "Reference: docs/api.md. Errors are application/problem+json (RFC 9457)."}};
+  doc["servers"] = json::array({{{"url", "/"}}});
+  doc["security"] = json::array({{{"bearer", json::array()}}});
+  json problemRef = {{"$ref", "#/components/schemas/problem"}};
+  json paths = json::object();
+  for (const RouteSpec& r : routeSpecs()) {
+    json op = {{"operationId", r.operationId}, {"summary", r.summary}};
+    const std::string path = r.path;
+    json parameters = json::array();
+    for (const std::string& p : pathParameters(path))
+      parameters.push_back({{"name", p}, {"in", "path"}, {"required", true}, {"schema", {{"type", "string"}}}});
+    if (!parameters.empty()) op["parameters"] = parameters;
+    if (r.requestSchema) {
+      op["requestBody"] = {
+          {"required", true},
+          {"content", {{"application/json", {{"schema", {{"$ref", std::string("#/components/schemas/") + r.requestSchema}}}}}}}};
+    }
+    if (path == "/v1/databases") {
+      op["requestBody"] = {{"required", true}, {"content", {{"application/x-hdf5", {{"schema", {{"type", "string"}, {"contentMediaType", "application/x-hdf5"}}}}}}}};
+    }
+    const std::string ok = std::string(r.method) == "post" && path == "/v1/databases" ? "201"
+                           : std::string(r.method) == "post"                       ? "202"
+                                                                                   : "200";
+    op["responses"] = {{ok, {{"description", r.summary}, {"content", {{r.responseType, json::object()}}}}},
+                       {"default", {{"description", "a problem (RFC 9457)"},
+                                    {"content", {{"application/problem+json", {{"schema", problemRef}}}}}}}};
+    if (!r.authenticated) op["security"] = json::array();
+    paths[path][r.method] = std::move(op);
+  }
+  doc["paths"] = std::move(paths);
+  doc["components"]["securitySchemes"]["bearer"] = {
+      {"type", "http"}, {"scheme", "bearer"}, {"description", "the server's token (rcfd --token or RCFD_TOKEN)"}};
+  doc["components"]["schemas"]["scene"] = component("scene");
+  doc["components"]["schemas"]["job"] = component("job");
+  json errorItem = {{"type", "object"},
+                    {"properties", {{"pointer", {{"type", "string"}}}, {"message", {{"type", "string"}}}}}};
+  json problem = {{"type", "object"}, {"required", {"type", "title", "status"}}};
+  problem["properties"] = {{"type", {{"type", "string"}}},     {"title", {{"type", "string"}}},
+                           {"status", {{"type", "integer"}}},  {"detail", {{"type", "string"}}},
+                           {"instance", {{"type", "string"}}}, {"errors", {{"type", "array"}, {"items", errorItem}}}};
+  doc["components"]["schemas"]["problem"] = std::move(problem);
+  return doc;
+}
+
+}  // namespace rcfd::server
