@@ -1,6 +1,7 @@
 #include "OpenApi.hpp"
 
 #include <regex>
+#include <sstream>
 
 #include "scene/SceneLoader.hpp"
 
@@ -9,14 +10,15 @@ namespace rcfd::server {
 const std::vector<RouteSpec>& routeSpecs() {
   static const std::vector<RouteSpec> routes = {
       {"post", "/v1/jobs", "submitJob", "Submit a job (202: queued)", "application/json", "job"},
-      {"get", "/v1/jobs", "listJobs", "List jobs, newest first, a page at a time", "application/json"},
+      {"get", "/v1/jobs", "listJobs", "List jobs, oldest first, a page at a time", "application/json", nullptr, true,
+       "state,kind,owner,page_size,page_token"},
       {"get", "/v1/jobs/{id}", "getJob", "A job's state, progress and summary", "application/json"},
       {"get", "/v1/jobs/{id}/events", "listJobEvents", "A job's state transitions", "application/json"},
       {"post", "/v1/jobs/{id}:cancel", "cancelJob", "Cancel a queued or running job", "application/json"},
       {"post", "/v1/jobs/{id}:retry", "retryJob", "Run a failed or cancelled job again", "application/json"},
       {"get", "/v1/jobs/{id}/result", "getJobResult", "A finished job's summary.json", "application/json"},
       {"get", "/v1/jobs/{id}/coverage", "getJobCoverage", "A spray job's coverage (format json, csv or h5)",
-       "application/json"},
+       "application/json", nullptr, true, "format,bins"},
       {"get", "/v1/jobs/{id}/artifacts/{name}", "getJobArtifact", "A file the job wrote", "application/octet-stream"},
       {"post", "/v1/databases", "uploadDatabase", "Upload a field database (HDF5; 201: stored)", "application/json"},
       {"get", "/v1/databases/{id}", "getDatabase", "An uploaded database's record", "application/json"},
@@ -81,6 +83,12 @@ json openApiDocument(const std::string& version) {
     json parameters = json::array();
     for (const std::string& p : pathParameters(path))
       parameters.push_back({{"name", p}, {"in", "path"}, {"required", true}, {"schema", {{"type", "string"}}}});
+    std::stringstream query(r.query);
+    for (std::string q; std::getline(query, q, ',');) {
+      const bool count = q == "page_size" || q == "bins";
+      parameters.push_back(
+          {{"name", q}, {"in", "query"}, {"required", false}, {"schema", {{"type", count ? "integer" : "string"}}}});
+    }
     if (!parameters.empty()) op["parameters"] = parameters;
     if (r.requestSchema) {
       op["requestBody"] = {

@@ -19,6 +19,7 @@ struct RouteSpec {
   const char* responseType;  ///< media type of the 200 (201) response
   const char* requestSchema = nullptr;  ///< embedded schema of the request body ("job"), or none
   bool authenticated = true;            ///< false: answered without the bearer token
+  const char* query = "";               ///< the optional query parameters, comma-separated
 };
 
 /// Every route, in the order docs/api.md lists them.

@@ -111,6 +111,15 @@ TEST_F(OpenApi, TheDocumentIsOpenApi31WhoseReferencesAndParametersHold) {
   ASSERT_NE(job, nullptr);
   const nlohmann::json served = request(http::verb::get, "/v1/schemas/job").json();
   EXPECT_EQ(job->at("properties").size(), served.at("properties").size());
+  // Query parameters where docs/api.md names them.
+  auto queryNames = [&](const std::string& path) {
+    std::set<std::string> names;
+    for (const auto& p : doc.at("paths").at(path).at("get").value("parameters", nlohmann::json::array()))
+      if (p.at("in") == "query") names.insert(p.at("name").get<std::string>());
+    return names;
+  };
+  EXPECT_EQ(queryNames("/v1/jobs"), (std::set<std::string>{"state", "kind", "owner", "page_size", "page_token"}));
+  EXPECT_EQ(queryNames("/v1/jobs/{id}/coverage"), (std::set<std::string>{"format", "bins"}));
   // Only health is answered without the token.
   for (const auto& [path, item] : doc.at("paths").items()) {
     for (const auto& [method, op] : item.items()) {
