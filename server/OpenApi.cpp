@@ -8,26 +8,28 @@
 namespace rcfd::server {
 
 const std::vector<RouteSpec>& routeSpecs() {
+  const char* const jsonType = "application/json";
   static const std::vector<RouteSpec> routes = {
-      {"post", "/v1/jobs", "submitJob", "Submit a job (202: queued)", "application/json", "job"},
-      {"get", "/v1/jobs", "listJobs", "List jobs, oldest first, a page at a time", "application/json", nullptr, true,
+      {"post", "/v1/jobs", "submitJob", "Submit a job (queued)", 202, jsonType, jsonType, "job"},
+      {"get", "/v1/jobs", "listJobs", "List jobs, oldest first, a page at a time", 200, jsonType, nullptr, nullptr, true,
        "state,kind,owner,page_size,page_token"},
-      {"get", "/v1/jobs/{id}", "getJob", "A job's state, progress and summary", "application/json"},
-      {"get", "/v1/jobs/{id}/events", "listJobEvents", "A job's state transitions", "application/json"},
-      {"post", "/v1/jobs/{id}:cancel", "cancelJob", "Cancel a queued or running job", "application/json"},
-      {"post", "/v1/jobs/{id}:retry", "retryJob", "Run a failed or cancelled job again", "application/json"},
-      {"get", "/v1/jobs/{id}/result", "getJobResult", "A finished job's summary.json", "application/json"},
-      {"get", "/v1/jobs/{id}/coverage", "getJobCoverage", "A spray job's coverage (format json, csv or h5)",
-       "application/json", nullptr, true, "format,bins"},
-      {"get", "/v1/jobs/{id}/artifacts/{name}", "getJobArtifact", "A file the job wrote", "application/octet-stream"},
-      {"post", "/v1/databases", "uploadDatabase", "Upload a field database (HDF5; 201: stored)", "application/json"},
-      {"get", "/v1/databases/{id}", "getDatabase", "An uploaded database's record", "application/json"},
-      {"get", "/v1/schemas/{name}", "getSchema", "The JSON Schema of scenes (scene) or jobs (job)",
+      {"get", "/v1/jobs/{id}", "getJob", "A job's state, progress and summary", 200, jsonType},
+      {"get", "/v1/jobs/{id}/events", "listJobEvents", "A job's state transitions", 200, jsonType},
+      {"post", "/v1/jobs/{id}:cancel", "cancelJob", "Cancel a queued or running job", 202, jsonType},
+      {"post", "/v1/jobs/{id}:retry", "retryJob", "Run a failed or cancelled job again", 202, jsonType},
+      {"get", "/v1/jobs/{id}/result", "getJobResult", "A finished job's summary.json", 200, jsonType},
+      {"get", "/v1/jobs/{id}/coverage", "getJobCoverage", "A spray job's coverage (format jsonType, csv or h5)", 200, jsonType,
+       nullptr, nullptr, true, "format,bins"},
+      {"get", "/v1/jobs/{id}/artifacts/{name}", "getJobArtifact", "A file the job wrote", 200,
+       "application/octet-stream"},
+      {"post", "/v1/databases", "uploadDatabase", "Upload a field database (HDF5)", 201, jsonType, "application/x-hdf5"},
+      {"get", "/v1/databases/{id}", "getDatabase", "An uploaded database's record", 200, jsonType},
+      {"get", "/v1/schemas/{name}", "getSchema", "The JSON Schema of scenes (scene) or jobs (job)", 200,
        "application/schema+json"},
-      {"get", "/v1/openapi.json", "getOpenApi", "This document", "application/json"},
-      {"get", "/v1/health", "getHealth", "Liveness, version and workers (no token)", "application/json", nullptr,
+      {"get", "/v1/openapi.json", "getOpenApi", "This document", 200, jsonType},
+      {"get", "/v1/health", "getHealth", "Liveness, version and workers (no token)", 200, jsonType, nullptr, nullptr,
        false},
-      {"get", "/metrics", "getMetrics", "Prometheus metrics", "text/plain"},
+      {"get", "/metrics", "getMetrics", "Prometheus metrics", 200, "text/plain"},
   };
   return routes;
 }
@@ -90,18 +92,12 @@ json openApiDocument(const std::string& version) {
           {{"name", q}, {"in", "query"}, {"required", false}, {"schema", {{"type", count ? "integer" : "string"}}}});
     }
     if (!parameters.empty()) op["parameters"] = parameters;
-    if (r.requestSchema) {
-      op["requestBody"] = {
-          {"required", true},
-          {"content", {{"application/json", {{"schema", {{"$ref", std::string("#/components/schemas/") + r.requestSchema}}}}}}}};
+    if (r.requestType) {
+      const json schema = r.requestSchema ? json{{"$ref", std::string("#/components/schemas/") + r.requestSchema}}
+                                          : json{{"type", "string"}, {"contentMediaType", r.requestType}};
+      op["requestBody"] = {{"required", true}, {"content", {{r.requestType, {{"schema", schema}}}}}};
     }
-    if (path == "/v1/databases") {
-      op["requestBody"] = {{"required", true}, {"content", {{"application/x-hdf5", {{"schema", {{"type", "string"}, {"contentMediaType", "application/x-hdf5"}}}}}}}};
-    }
-    const std::string ok = std::string(r.method) == "post" && path == "/v1/databases" ? "201"
-                           : std::string(r.method) == "post"                       ? "202"
-                                                                                   : "200";
-    op["responses"] = {{ok, {{"description", r.summary}, {"content", {{r.responseType, json::object()}}}}},
+    op["responses"] = {{std::to_string(r.status), {{"description", r.summary}, {"content", {{r.responseType, json::object()}}}}},
                        {"default", {{"description", "a problem (RFC 9457)"},
                                     {"content", {{"application/problem+json", {{"schema", problemRef}}}}}}}};
     if (!r.authenticated) op["security"] = json::array();

@@ -16,8 +16,10 @@ struct RouteSpec {
   const char* path;         ///< template: {id}, {name}; a custom method as in /v1/jobs/{id}:cancel
   const char* operationId;  ///< camelCase
   const char* summary;
-  const char* responseType;  ///< media type of the 200 (201) response
-  const char* requestSchema = nullptr;  ///< embedded schema of the request body ("job"), or none
+  int status;                ///< of a success: 200, 201 (stored) or 202 (accepted)
+  const char* responseType;  ///< media type of the success
+  const char* requestType = nullptr;    ///< media type of the request body, or none
+  const char* requestSchema = nullptr;  ///< embedded schema of that body ("job"), or none
   bool authenticated = true;            ///< false: answered without the bearer token
   const char* query = "";               ///< the optional query parameters, comma-separated
 };

@@ -31,6 +31,7 @@
 
 #include "core/Errors.hpp"
 #include "core/Permutation.hpp"
+#include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/NormalTable.hpp"
 #include "tracers/OrnsteinUhlenbeckStep.hpp"
@@ -101,6 +102,7 @@ class LangevinVelocityEffect final : public TracerEffect {
     float* u[3] = {fluctuation_[0].data(), fluctuation_[1].data(), fluctuation_[2].data()};
     const float* coefficients = coefficients_.data();
     const double* alpha = alpha_.data();
+    const CellIndexer cells(ctx.grid);
     const NormalTable& normals = NormalTable::instance();
     const bool owner = owner_;
 #pragma omp parallel for schedule(static) if (std::int64_t(n) > kParallelThreshold)
@@ -132,7 +134,10 @@ class LangevinVelocityEffect final : public TracerEffect {
       // The fluctuation is the particles' own: it does not carry a tracer where the frame holds none (the
       // bed's free surface, the rim of a jet). Reflected there, as at a wall, it keeps the tracers within
       // the particle phase, whose edge the drift alone, taken between cell centres, does not hold.
-      if (alpha[std::size_t(ctx.grid.flatIndexOf(here + ctx.dt * step))] <= 0.0) step = -step, next = -next;
+      const Eigen::Vector3d end = here + ctx.dt * step;
+      std::int32_t endCell;
+      cells.cellsOf(1, &end.x(), &end.y(), &end.z(), &endCell);
+      if (alpha[std::size_t(endCell)] <= 0.0) step = -step, next = -next;
       for (int d = 0; d < 3; ++d) {
         u[d][i] = float(next[d]);
         out[d][i] = owner ? float(step[d]) : out[d][i] + float(step[d]);
