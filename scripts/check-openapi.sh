@@ -1,25 +1,25 @@
 #!/usr/bin/env bash
 # Validates the OpenAPI document rcfd-server serves (/v1/openapi.json) against the official OpenAPI 3.1
-# meta-schema with the npm package @seriousme/openapi-schema-validator (installed into a temporary
-# directory; needs Node.js >= 18 and the npm registry). Usage: bash scripts/check-openapi.sh [BUILD_DIR]
+# meta-schema with the npm package @seriousme/openapi-schema-validator (tests/openapi/package-lock.json,
+# installed with `npm ci` into BUILD_DIR/openapi-check). Needs Node.js >= 18 and npm; the ctest test
+# openapi.ValidatesAsOpenApi31 runs it. Usage: bash scripts/check-openapi.sh [BUILD_DIR]
+# Exit 0 valid, 1 invalid or failed, 77 without node or npm (ctest: skipped).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=$(realpath "${1:-build}")
-command -v node > /dev/null && command -v npm > /dev/null || { echo "$0: needs node and npm" >&2; exit 2; }
+if ! command -v node > /dev/null || ! command -v npm > /dev/null; then
+  echo "$0: skipped: needs node and npm (scripts/install-deps.sh installs them)" >&2
+  exit 77
+fi
+check="$bin/openapi-check"
+mkdir -p "$check"
+cp tests/openapi/package.json tests/openapi/package-lock.json tests/openapi/validate.mjs "$check/"
+if ! cmp -s tests/openapi/package-lock.json "$check/node_modules/.package-lock.json.rcfd" 2>/dev/null; then
+  (cd "$check" && npm ci --silent --no-audit --no-fund)
+  cp tests/openapi/package-lock.json "$check/node_modules/.package-lock.json.rcfd"
+fi
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
 source scripts/server-lib.sh
 start_rcfd_server "$bin" "$work/data" "$work/logs"
-curl -sf -H "Authorization: Bearer $RCFD_TOKEN" "$RCFD_SERVER/v1/openapi.json" > "$work/openapi.json"
-(cd "$work" && npm init -y > /dev/null && npm install --silent @seriousme/openapi-schema-validator@2 > /dev/null)
-cat > "$work/validate.mjs" <<'JS'
-import { Validator } from "@seriousme/openapi-schema-validator";
-const validator = new Validator();
-const result = await validator.validate(process.argv[2]);
-if (!result.valid) {
-  console.error(JSON.stringify(result.errors, null, 1));
-  process.exit(1);
-}
-console.log(`valid OpenAPI ${validator.version}`);
-JS
-(cd "$work" && node validate.mjs "$work/openapi.json")
+trap 'kill "$rcfd_server_pid" 2>/dev/null || true; wait "$rcfd_server_pid" 2>/dev/null || true; rm -rf "$work"' EXIT
+(cd "$check" && node validate.mjs "$RCFD_SERVER" "$RCFD_TOKEN")

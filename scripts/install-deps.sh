@@ -17,6 +17,9 @@ packages=(
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
 )
+# Node.js and npm run the OpenAPI meta-schema validator (tests/openapi); a Node.js from elsewhere that
+# brings its own npm is kept.
+command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
