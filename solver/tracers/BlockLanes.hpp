@@ -14,6 +14,8 @@
 
 #include "tracers/BlockSampling.hpp"
 #include "tracers/CellIndex.hpp"
+#include "tracers/CounterRng.hpp"
+#include "tracers/FrameSampler.hpp"
 
 namespace rcfd::block {
 
@@ -59,7 +61,7 @@ struct LaneStorage {
 
 /// The lanes k < n with v[k] > 0, in lane order, into `out`; returns their number. A bit mask of them
 /// first (eight lanes per compare with AVX2), then its set bits: where few lanes qualify, a lane-by-lane
-/// pass over all 64 took 40% of defer(), and a branch per lane mispredicts.
+/// pass over all 64 costs more than the mask, and a branch per lane mispredicts.
 inline int positiveLanes(const std::int32_t* v, int n, std::int32_t* out) {
   static_assert(kBlock <= 64, "one bit per lane in a 64-bit mask");
   std::uint64_t mask = 0;
@@ -93,15 +95,15 @@ inline int countLanesWithSubstepsLeft(const Lanes& lanes) {
 
 /// A block whose lanes with sub-steps left after their first are at least this many takes those
 /// sub-steps in place (MotionKernel::advanceInPlace()), every lane in every round; fewer are deferred.
-/// Break-even: a deferred lane costs its copies (about 9 ns) plus its share of a full round, a
-/// round in place about as much as 64 lanes' rounds; in the benchmark's spout every lane has one.
+/// Break-even: a deferred lane costs its copies plus its share of a full round, a round in place
+/// about as much as 64 lanes' rounds; in the benchmark's spout every lane has one.
 constexpr int kInPlaceLanes = 32;
 
 /// Lanes, from the blocks a thread moves, with sub-steps left after their first: moved together when
 /// the storage is full or the thread has no chunk left, so later sub-steps run on full vectors rather
-/// than on the one or two lanes a block has (each round has a fixed cost: in the benchmark 2.2% of the
-/// tracers took 19% of the kernel's time in per-block rounds). Which lanes share a round depends on the
-/// schedule; a lane's arithmetic does not.
+/// than on the one or two lanes a block has (each round has a fixed cost, which per-block rounds of
+/// a few lanes would pay many times). Which lanes share a round depends on the schedule; a lane's
+/// arithmetic does not.
 struct DeferredLanes {
   LaneStorage s;
   std::int64_t tracer[kBlock];  ///< the lane's tracer
@@ -146,6 +148,44 @@ struct Context {
   const CellIndexer* cellIndexer = nullptr;
 };
 
+/// The cloud's coordinate and velocity arrays.
+struct Cloud {
+  double *x, *y, *z, *vx, *vy, *vz;
+};
+
+/// What every block of a step reads besides the Context: the cloud and the step's per-tracer inputs.
+struct StepInputs {
+  Cloud cloud{};
+  const Context* context = nullptr;
+  const std::int32_t* ids = nullptr;          ///< the tracers' ids (their random streams)
+  const FrameSampler* sampler = nullptr;      ///< alpha_P^rec (free flight)
+  const CellIndexer* indexer = nullptr;
+  const CounterRngPrefix* rngPrefix = nullptr;
+  const std::int32_t* tracerCell = nullptr;   ///< the cells tracer_volume_fraction found, or null
+  bool fluctuate = false;                     ///< Eq. (10) on
+  const float *streamX = nullptr, *streamY = nullptr, *streamZ = nullptr;  ///< velocity_streams, or null
+  double dt = 0.0;                            ///< [s]
+  double inverseCellLimit = 0.0;              ///< 1 / (max_courant x smallest spacing) [1/m]
+};
+
+/// A block's lanes at the start of the step: their cells, which are in free flight, their cells' reach
+/// (the first wall test) and u_fluc (Eq. (10), with the stream velocity).
+struct BlockStart {
+  alignas(64) float ax[kBlock], ay[kBlock], az[kBlock];  ///< u_fluc [m/s]
+  alignas(64) float reach[kBlock];                       ///< MotionKernel::cellData_'s reach of the lane's cell [m]
+  alignas(64) std::int32_t cellsFound[kBlock];
+  const std::int32_t* cell = nullptr;  ///< the lanes' cells: StepInputs::tracerCell + i0, or cellsFound
+  std::int64_t free[kBlock];           ///< free flight (not bool, which stops the vectoriser)
+  std::int64_t freeLanes = 0;
+};
+
+/// A thread's lanes with sub-steps left, carried from block to block so that their rounds run full,
+/// and its stencils.
+struct ThreadLanes {
+  DeferredLanes deferred, deferredFree;
+  BlockStencils stencils;
+};
+
 /// Eq. (9): u = u_P^rec + u_fluc at the lanes' positions, located in float grid coordinates: into the
 /// lanes' velocities, and in float with the grid coordinates into `s` (the midpoint rule steps from them).
 inline void sampleParticleVelocity(const Context& bc, Lanes& L, BlockStencils& s) {
@@ -159,14 +199,13 @@ inline void sampleParticleVelocity(const Context& bc, Lanes& L, BlockStencils& s
 constexpr double kOneSubstepMargin = 1.0 - 1e-9;
 
 /// Sub-steps of the lanes of a block so that none moves farther than max_courant cells at its start
-/// velocity u: the arithmetic of substepsFor() in MotionKernel::move() (courant = |u| dt / limit,
-/// given as its inverse, capped at kMax, also for a non-finite u). The sub-step lengths come from
-/// `lengths` (lengths[n] = dt / n, as there) on AVX-512, where the table gather beat a vector division;
-/// elsewhere from the division itself (GCC does not gather on Zen, and the table loaded lane by lane
-/// took 40% of this function's instructions). Adds the extra sub-steps and the capped lanes to the counters;
-/// returns the largest number of extra sub-steps. Not inlined: inlined into MotionKernel::move(), GCC 12
-/// leaves the loop scalar for AVX2 ("control flow in loop"), out of line it vectorises it (33.4 against
-/// 37.2 CPU ns per tracer-step on a Zen 3).
+/// velocity u: the arithmetic of ReferenceMotion::substepsFor() (courant = |u| dt / limit, given as
+/// its inverse, capped at kMax, also for a non-finite u). The sub-step lengths come from `lengths`
+/// (lengths[n] = dt / n, as there) on AVX-512, where the table gather beats a vector division;
+/// elsewhere from the division itself (GCC does not gather on Zen, and a table loaded lane by lane is
+/// slower). Adds the extra sub-steps and the capped lanes to the counters; returns the largest number
+/// of extra sub-steps. Not inlined: inlined into its caller, GCC 12 leaves the loop scalar for AVX2
+/// ("control flow in loop"); out of line it vectorises it.
 [[gnu::noinline]] inline std::int32_t substepsOfBlock(const double* ux, const double* uy, const double* uz,
                                                       int count, double dt, double inverseLimit,
                                                       [[maybe_unused]] const double* lengths, double kMax,
@@ -205,7 +244,7 @@ constexpr double kOneSubstepMargin = 1.0 - 1e-9;
     const double c = within ? courant : kMax;  // in [0, kMax]
     // ceil(c) in integers: GCC 12 vectorises neither ceil (without -fno-trapping-math) nor, for AVX2
     // (no masked operations), a select between rounded doubles; it left this loop scalar with two
-    // branches that mispredict at every Courant boundary, 13% of a step on a Zen 3.
+    // branches that mispredict at every Courant boundary.
     const std::int32_t whole = std::int32_t(c);  // floor, as c >= 0
     const std::int32_t up = whole + std::int32_t(double(whole) < c);
     const std::int32_t nsub = up > 1 ? up : 1;

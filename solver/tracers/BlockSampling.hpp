@@ -5,11 +5,10 @@
 /// With AVX2 and FMA and 4 floats per cell, a lane's corners come in as 4 contiguous 32-byte loads (the
 /// x-neighbours of a corner are adjacent in memory) and are combined two corners and 3 components at a
 /// time: 4 loads and 7 vector operations in place of 24 element gathers (AVX-512 gathers cost about one
-/// load per element), 1.4x on the whole tracer step. (3 floats per cell, the frames' layout, would save
-/// the step field's copy, but its pair loads split cache lines more often and need a shuffle: the
-/// tracer step took 3-5% longer, measured with bench/ab-tracers.sh.) Both the block path and the scalar
-/// path combine corners with interpolateCorners() (float, fused multiply-adds, z then y then x), so they
-/// give bit-identical velocities. Internal to the motion kernel.
+/// load per element). (3 floats per cell, the frames' layout, would save the step field's copy, but its
+/// pair loads split cache lines more often and need a shuffle; docs/performance.md.) Both the block path
+/// and ReferenceMotion combine corners with interpolateCorners() (float, fused multiply-adds, z then y
+/// then x), so they give bit-identical velocities. Internal to the motion kernel.
 
 #include <bit>
 #include <cmath>

@@ -6,38 +6,52 @@
 /// reflection at the apparatus's exact walls. Tracers faster than one cell per step are sub-stepped
 /// (particle Courant number <= max_courant). Each tracer is independent and draws from its own
 /// counter-based random stream, so results are bit-identical for any thread count.
+///
+/// What a tracer does is defined by ReferenceMotion (ReferenceMotion.hpp), one tracer at a time. This
+/// kernel does the same to blocks of 64 tracers (block::kBlock) in loops the compiler vectorises; the
+/// test Kernel.BlockPathMatchesTheReferenceMotionOnRandomCases holds the two together. Its strategies:
+///  - **Per-cell work once per step** (prepare()): Eq. (10)'s speed depends on the cell only, so it is
+///    computed per cell, beside each cell's wall reach, and a lane reads both with one load.
+///  - **Blocks in place** (startBlock(), moveBlock()): a block's lanes are the cloud's own arrays; only
+///    a block with tracers in free flight copies its two kinds of lanes apart (takeLanes()).
+///  - **Two wall tests before the exact one** (moveLanes(), MotionKernelBlock.cpp): a move shorter
+///    than its cell's wall reach, or clear of every half-space of the open region near its cell and of
+///    the plates, cannot meet a wall; only the others take ReferenceMotion's exact segment test.
+///  - **Sub-steps three ways**: most tracers take one sub-step (the block's first round); a block in
+///    which most lanes need more takes them in place, every lane in every round (advanceInPlace(),
+///    lanes done stand still); otherwise its few such lanes are deferred and gathered across blocks
+///    until 64 move together (defer(), finishDeferred()), so later rounds run on full vectors.
+///  - **The next step's cells** are found for a chunk of blocks while its positions are in cache
+///    (TracerContext::nextTracerCell), with the one CellIndexer every user of a tracer's cell shares.
+/// Dynamic chunks of 16 blocks balance the threads: sub-stepped and near-wall tracers cluster.
+/// Measured costs of each strategy: docs/performance.md, "Tracers (`rcfd-bench tracers`)".
 
 #include <cstdint>
 #include <functional>
 #include <vector>
 
 #include "geometry/Apparatus.hpp"
+#include "tracers/MotionStatistics.hpp"
+#include "tracers/ReferenceMotion.hpp"
 #include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
 namespace block {
+struct BlockStart;
 struct BlockStencils;
 struct Context;
 struct DeferredLanes;
 struct Lanes;
+struct StepInputs;
+struct ThreadLanes;
 }  // namespace block
 
-/// Counters of the last step (for diagnostics and tests).
-struct MotionStatistics {
-  std::int64_t substeps = 0;        ///< sub-steps taken beyond the first
-  std::int64_t wallHits = 0;        ///< reflections
-  std::int64_t freeFlight = 0;      ///< tracers in free flight
-  std::int64_t substepCapped = 0;   ///< tracers that needed more than kMaxSubsteps
-  std::int64_t scalarPath = 0;      ///< tracers moved one by one (free flight, or the block path off)
-  std::int64_t exactWallTests = 0;  ///< block-path sub-steps that needed the exact segment test
-  std::int64_t blocksInPlace = 0;   ///< blocks whose later sub-steps ran in place (advanceInPlace())
-};
 
 class MotionKernel {
  public:
-  static constexpr int kMaxSubsteps = 64;   ///< beyond this, walls still hold (exact segment tests)
-  static constexpr int kMaxBounces = 16;    ///< reflections within one sub-step before stopping
+  static constexpr int kMaxSubsteps = ReferenceMotion::kMaxSubsteps;  ///< beyond this, walls still hold
+  static constexpr int kMaxBounces = ReferenceMotion::kMaxBounces;    ///< reflections within one move
 
   MotionKernel(const TracerContext& ctx, const MotionSettings& settings);
 
@@ -49,15 +63,22 @@ class MotionKernel {
   const MotionSettings& settings() const { return settings_; }
 
   /// Moves p by disp, reflecting at walls (mirror of the remaining displacement); v is reflected with
-  /// the restitution coefficient if `velocity` is non-null. Returns the number of reflections.
-  /// `clearance`, if >= 0, is the wall clearance of p's cell (saves looking it up).
-  int moveWithWalls(Eigen::Vector3d& p, Eigen::Vector3d disp, Eigen::Vector3d* velocity,
-                    double restitution, double clearance = -1.0) const;
+  /// the restitution coefficient if `velocity` is non-null. Returns the number of reflections. The
+  /// exact test of ReferenceMotion::moveReflecting(): the block path's moves its own tests do not clear.
+  int moveWithWalls(Eigen::Vector3d& p, const Eigen::Vector3d& disp, Eigen::Vector3d* velocity,
+                    double restitution) const;
 
  private:
   /// Builds the step's velocity fields and cell table from the context's frames and tracer alpha_P.
   void prepare(TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
-  // The block path (MotionKernelBlock.cpp).
+  /// The step's constants of the block path: fields, grid and walls as plain values.
+  block::Context blockContext(const TrilinearLocator& locator, double dt) const;
+  /// A block's start: its lanes' cells, which are in free flight, their cells' reach and u_fluc.
+  void startBlock(const block::StepInputs& in, std::int64_t i0, int count, block::BlockStart& b) const;
+  /// A block's move: its first sub-step, the later ones in place or deferred, and its free flight.
+  void moveBlock(const block::StepInputs& in, std::int64_t i0, int count, block::BlockStart& b,
+                 block::ThreadLanes& thread, MotionStatistics& st) const;
+  // The block path's sub-step rounds (MotionKernelBlock.cpp).
   /// The sub-steps after the first of lanes: rounds on the lanes that still have some, compacted.
   void advanceLanes(block::Lanes& lanes, std::int32_t maxLeft, block::BlockStencils& stencils, bool freeFlying,
                     const block::Context& bc, MotionStatistics& st) const;
@@ -86,7 +107,7 @@ class MotionKernel {
   MotionSettings settings_;
   const Apparatus& apparatus_;
   const CartesianGrid& grid_;
-  std::vector<float> clearance_;  ///< lower bound of the wall distance from any point of each cell [m]
+  ReferenceMotion reference_;  ///< every tracer when settings_.vectorised is false; the exact wall test
   std::vector<float> reach_;      ///< wall distance of each cell centre less the hit band [m]
   std::vector<float> plateReach_; ///< draft-plate distance of each cell centre less the band [m] (plates only)
   std::vector<Apparatus::HalfSpace> halfSpaces_;  ///< the open region's convex part

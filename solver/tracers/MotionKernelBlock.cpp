@@ -153,7 +153,7 @@ void MotionKernel::moveLanes(block::Lanes& L, const block::Context& bc, MotionSt
   int k0 = 0;
 #if defined(__AVX2__) && !defined(__AVX512F__)
   // Blends and plain stores: GCC turns this loop, even written as selects, into AVX2 masked stores
-  // (vmaskmovpd), which are slow on AMD cores; they took a quarter of moveLanes() on a Zen 3.
+  // (vmaskmovpd), which are slow on AMD cores.
   for (; k0 + 4 <= m; k0 += 4) {
     const __m256d move = _mm256_castsi256_pd(_mm256_cmpgt_epi64(
         _mm256_load_si256(reinterpret_cast<const __m256i*>(fast + k0)), _mm256_setzero_si256()));
