@@ -190,10 +190,10 @@ std::string sidecarPath(const std::string& h5Path) {
   return std::filesystem::path(h5Path).replace_extension(".xmf").string();
 }
 
-std::string sidecarXml(const std::string& h5Path, const SidecarContent& content) {
-  const CellGrid& g = content.grid;
+std::string sidecarXml(const std::string& h5Path, const CellGrid& g, const std::vector<LayerMap>& layerMaps,
+                       const std::optional<FrameSeries>& frames) {
   const std::vector<DatasetInfo> datasets = numericDatasets(h5Path);
-  const std::string groupPrefix = content.frames ? content.frames->group + "/" : std::string();
+  const std::string groupPrefix = frames ? frames->group + "/" : std::string();
 
   struct Field {
     const DatasetInfo* data;
@@ -201,15 +201,17 @@ std::string sidecarXml(const std::string& h5Path, const SidecarContent& content)
   };
   std::vector<Field> statics, series;
   for (const DatasetInfo& d : datasets) {
-    const bool inSeriesGroup = content.frames && d.path.rfind(groupPrefix, 0) == 0;
+    const bool inSeriesGroup = frames && d.path.rfind(groupPrefix, 0) == 0;
     if (inSeriesGroup) {
       const bool direct = d.path.find('/', groupPrefix.size()) == std::string::npos;
       const std::string type = cellFieldType(d.dims, 1, g);
-      if (direct && !type.empty() && std::int64_t(d.dims[0]) >= content.frames->frames) series.push_back({&d, type});
+      if (direct && !type.empty() && std::int64_t(d.dims[0]) >= frames->frames) series.push_back({&d, type});
     } else if (const std::string type = cellFieldType(d.dims, 0, g); !type.empty()) {
       statics.push_back({&d, type});
     }
   }
+
+  if (statics.empty() && series.empty() && layerMaps.empty()) return {};
 
   Writer w(std::filesystem::path(h5Path).filename().string());
   w.line(0, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
@@ -218,8 +220,8 @@ std::string sidecarXml(const std::string& h5Path, const SidecarContent& content)
   auto staticAttributes = [&](int indent) {
     for (const Field& f : statics) w.wholeAttribute(indent, relativeName(*f.data), f.type, *f.data, f.data->dims);
   };
-  if (content.frames) {
-    const FrameSeries& s = *content.frames;
+  if (frames) {
+    const FrameSeries& s = *frames;
     w.line(2, "<Grid Name=\"" + escapeXml(s.group.substr(1)) + "\" GridType=\"Collection\" CollectionType=\"Temporal\">");
     for (std::int64_t n = 0; n < s.frames; ++n) {
       w.line(3, "<Grid Name=\"frame " + number(n) + "\" GridType=\"Uniform\">");
@@ -240,7 +242,7 @@ std::string sidecarXml(const std::string& h5Path, const SidecarContent& content)
   }
 
   std::map<std::int64_t, std::vector<const DatasetInfo*>> mapsOfLayer;
-  for (const LayerMap& m : content.layerMaps) {
+  for (const LayerMap& m : layerMaps) {
     const auto found = std::find_if(datasets.begin(), datasets.end(), [&](const DatasetInfo& d) { return d.path == m.dataset; });
     const std::vector<hsize_t> plane{hsize_t(g.shape[1]), hsize_t(g.shape[0])};
     if (found == datasets.end() || found->dims != plane) {
@@ -266,9 +268,16 @@ std::string sidecarXml(const std::string& h5Path, const SidecarContent& content)
   return w.text();
 }
 
-void writeSidecar(const std::string& h5Path, const SidecarContent& content) {
-  const std::string xml = sidecarXml(h5Path, content);
+bool writeSidecar(const std::string& h5Path, const CellGrid& grid, const std::vector<LayerMap>& layerMaps,
+                  const std::optional<FrameSeries>& frames) {
+  const std::string xml = sidecarXml(h5Path, grid, layerMaps, frames);
   const std::string path = sidecarPath(h5Path), tmp = path + ".tmp";
+  if (xml.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    if (ec) throw RunError("cannot remove the outdated XDMF sidecar " + path + ": " + ec.message());
+    return false;
+  }
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     out << xml;
@@ -278,6 +287,7 @@ void writeSidecar(const std::string& h5Path, const SidecarContent& content) {
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) throw RunError("cannot rename " + tmp + " to " + path + ": " + ec.message());
+  return true;
 }
 
 }  // namespace rcfd::xdmf

@@ -37,13 +37,6 @@ struct FrameSeries {
   double dt = 0.0;
 };
 
-/// What a sidecar shows beyond the cell fields it finds by their shape.
-struct SidecarContent {
-  CellGrid grid;
-  std::vector<LayerMap> layerMaps;
-  std::optional<FrameSeries> frames;
-};
-
 /// `path` with its extension replaced by ".xmf" (result.h5 -> result.xmf).
 std::string sidecarPath(const std::string& h5Path);
 
@@ -55,11 +48,15 @@ std::string sidecarPath(const std::string& h5Path);
 ///   (named by its name in the group) and the time n * dt, each also carrying the static arrays above;
 ///   without: one grid "cells" holding the static arrays (none if there are none);
 /// - one grid per layer of `layerMaps`, holding the maps of that layer.
-/// Throws rcfd::RunError when the file cannot be read or a layer map is not a [ny][nx] dataset.
-std::string sidecarXml(const std::string& h5Path, const SidecarContent& content);
+/// Empty when there is nothing to show (no cell field, no frame, no layer map). Throws rcfd::RunError
+/// when the file cannot be read or a layer map is not a [ny][nx] dataset.
+std::string sidecarXml(const std::string& h5Path, const CellGrid& grid, const std::vector<LayerMap>& layerMaps = {},
+                       const std::optional<FrameSeries>& frames = std::nullopt);
 
-/// Writes sidecarXml() to sidecarPath(h5Path) (through a temporary file and a rename); throws
-/// rcfd::RunError naming the file when it cannot be written.
-void writeSidecar(const std::string& h5Path, const SidecarContent& content);
+/// Writes sidecarXml() to sidecarPath(h5Path) (through a temporary file and a rename) and returns true;
+/// when it is empty, removes a sidecar left there by an earlier run and returns false. Throws
+/// rcfd::RunError naming the file when it cannot be written or removed.
+bool writeSidecar(const std::string& h5Path, const CellGrid& grid, const std::vector<LayerMap>& layerMaps = {},
+                  const std::optional<FrameSeries>& frames = std::nullopt);
 
 }  // namespace rcfd::xdmf
