@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -23,8 +24,10 @@ using nlohmann::json;
 
 namespace {
 
-/// pvpython, or a python3 that imports paraview.simple and h5py; empty when there is neither.
+/// $RCFD_PVPYTHON when set (a ParaView installed elsewhere, e.g. Kitware's binaries), else pvpython on the
+/// PATH, else a python3 that imports paraview.simple and h5py; empty when there is none of them.
 std::string paraviewPython() {
+  if (const char* chosen = std::getenv("RCFD_PVPYTHON")) return ::access(chosen, X_OK) == 0 ? chosen : std::string();
   const char* path = std::getenv("PATH");
   std::stringstream dirs(path ? path : "");
   for (std::string dir; std::getline(dirs, dir, ':');) {
@@ -58,8 +61,9 @@ CommandResult runCommand(const std::string& command) {
 TEST(ParaView, OpensEveryJobOutputThroughItsSidecar) {
   const std::string python = paraviewPython();
   if (python.empty()) {
-    GTEST_SKIP() << "ParaView's Python is not installed (neither pvpython nor python3 with paraview.simple and "
-                    "h5py): install paraview, python3-paraview and python3-h5py (scripts/install-deps.sh)";
+    GTEST_SKIP() << "ParaView's Python is not installed (neither $RCFD_PVPYTHON, pvpython nor python3 with "
+                    "paraview.simple and h5py): install paraview, python3-paraview and python3-h5py "
+                    "(scripts/install-deps.sh)";
   }
   const auto start = std::chrono::steady_clock::now();
   const fs::path dir = fs::path(testing::TempDir()) / ("paraview-" + std::to_string(::getpid()));
@@ -95,9 +99,13 @@ TEST(ParaView, OpensEveryJobOutputThroughItsSidecar) {
     ASSERT_TRUE(fs::exists(s)) << s;
     command += " " + s.string();
   }
+  // The calibration's mid-plane maps: the recurrence's and one per D0 run (the sweep may have grown).
   command += " --layer-map /calibration/recurrence/alpha_p_midplane";
-  for (const char* run : {"d0_0", "d0_1"})
-    command += std::string(" --layer-map /calibration/runs/") + run + "/field_average/alpha_p_midplane";
+  const json calibrationSummary = json::parse(std::ifstream(dir / "calibration" / "out" / "summary.json"));
+  const std::size_t runs = calibrationSummary.at("d0").size();
+  ASSERT_GE(runs, 2u);
+  for (std::size_t i = 0; i < runs; ++i)
+    command += " --layer-map /calibration/runs/d0_" + std::to_string(i) + "/field_average/alpha_p_midplane";
   // The fields each kind of file must show; the script finds the others by their shape.
   for (const char* name : {"alpha_p", "u_p", "u_g", "grid/fluid_fraction", "fields/alpha_p_mean",
                            "deposition_maps/rate_density", "field_average/alpha_p_tracers",
