@@ -1,10 +1,9 @@
 #include "core/Xdmf.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
-#include <limits>
-#include <locale>
 #include <map>
 #include <sstream>
 
@@ -91,14 +90,12 @@ std::string escapeXml(const std::string& text) {
   return out;
 }
 
-/// Numbers as XML text: shortest round-trip form, never the locale's decimal comma.
+/// Numbers as XML text: the shortest form that reads back to the same value, never the locale's comma.
 template <class T>
 std::string number(T value) {
-  std::ostringstream s;
-  s.imbue(std::locale::classic());
-  s.precision(std::numeric_limits<double>::max_digits10);
-  s << value;
-  return s.str();
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+  return std::string(text, end);
 }
 
 template <class Sequence>
