@@ -206,6 +206,7 @@ class CalibrationJob final : public JobRunner {
         out.flush();
       }
       fs::rename(dir + "/result.h5.tmp", dir + "/result.h5");
+      xdmf::writeSidecar(dir + "/result.h5", xdmfGrid(rec.database->grid()));
       writeFileAtomically(dir + "/summary.json", summary.dump(2) + "\n");
       fs::remove(checkpoint);
       spdlog::info("D0 = {} m2/s: penalty {:.4g}", d0[i], summary["probes"]["penalty_mean"].get<double>());
@@ -295,6 +296,15 @@ class CalibrationJob final : public JobRunner {
     {
       h5::File out(options.outDir + "/result.h5", h5::File::Mode::ReadWrite);
       out.write("/path/frames", std::vector<std::int64_t>(rec.path.frames.begin(), rec.path.frames.end()));
+    }
+    {
+      // The report's fields are mid-plane maps of one cell layer: the recurrence average and each run's.
+      const CartesianGrid& grid = rec.database->grid();
+      const std::int64_t layer = analysis::midplaneLayer(scene, grid);
+      std::vector<xdmf::LayerMap> maps{{"/calibration/recurrence/alpha_p_midplane", layer}};
+      for (std::size_t i = 0; i < d0.size(); ++i)
+        maps.push_back({"/calibration/runs/d0_" + std::to_string(i) + "/field_average/alpha_p_midplane", layer});
+      xdmf::writeSidecar(options.outDir + "/result.h5", xdmfGrid(grid), maps);
     }
     summary["kind"] = job.kind;
     summary["status"] = "succeeded";

@@ -37,6 +37,7 @@
 #include "jobs/Cancellation.hpp"
 #include "jobs/DatabaseProgress.hpp"
 #include "jobs/JobRunner.hpp"
+#include "jobs/JobSupport.hpp"
 #include "jobs/Progress.hpp"
 #include "spray/ReferenceCoverage.hpp"
 #include "tracers/TracerEffect.hpp"
@@ -278,6 +279,8 @@ class DatabaseJob final : public JobRunner {
       if (coverage) coverage->write(db);
       db.flush();
     }
+    xdmf::writeSidecar(databasePath, xdmfGrid(sim.grid()), {},
+                       xdmf::FrameSeries{"/frames", st.framesWritten, plan.dtRec()});
 
     const double wall = st.wallTime + elapsed();
     const std::size_t parcels = sim.dem().particles().size();
@@ -402,6 +405,7 @@ class DatabaseJob final : public JobRunner {
       out.flush();
     }
     fs::rename(outDir + "/result.h5.tmp", outDir + "/result.h5");
+    xdmf::writeSidecar(outDir + "/result.h5", xdmfGrid(db->grid()));
     if (stopRequested()) throw Cancelled("stopped before drawing the figures");
     if (scene.outputs.svg) {
       analysis::PressureDropSeries dp{rec.pressureDrop(), rec.dt(), 0.0, std::nullopt};

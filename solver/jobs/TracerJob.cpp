@@ -114,6 +114,7 @@ nlohmann::json writeRunResults(const JobSpec& job, const TracerSimulation& sim, 
     out.flush();
   }
   std::filesystem::rename(dir + "/result.h5.tmp", dir + "/result.h5");
+  xdmf::writeSidecar(dir + "/result.h5", xdmfGrid(sim.context().grid));
   poll();
   summary["stay_comparison"] = stayComparison(job, scene, dir + "/result.h5", steps);
   summary["coverage_comparison"] =
@@ -407,6 +408,7 @@ class TracerJob final : public JobRunner {
       out.flush();
     }
     fs::rename(options.outDir + "/result.h5.tmp", options.outDir + "/result.h5");
+    xdmf::writeSidecar(options.outDir + "/result.h5", xdmfGrid(rec.database->grid()));
     pollInResults();
     if (scene.outputs.svg && summary["ensemble"].contains(nlohmann::json::json_pointer("/coverage/histogram"))) {
       writeEnsembleCoverageFigure(summary["ensemble"], double(steps) * scene.rcfd.dt, options.outDir);

@@ -20,6 +20,7 @@
 #include <set>
 
 #include "analysis/ReferenceStatistics.hpp"
+#include "SmallScenes.hpp"
 #include "SolveProcess.hpp"
 #include "core/Hdf5.hpp"
 #include "fields/FieldDatabase.hpp"
@@ -60,24 +61,7 @@ constexpr double kParcelDiameter = 0.003;
 constexpr double kDensity = 1040.0;
 constexpr double kBedMass = 0.005;  // 340 parcels of 3 mm
 
-json sceneDocument() {
-  json s = json::parse(R"({
-    "name": "database-job-test",
-    "apparatus": {"type": "box", "size": [0.04, 0.1, 0.02]},
-    "grid": {"cell_size": 0.005},
-    "gas": {},
-    "particles": {"diameter": 0.003, "density": 1040.0},
-    "process": {"bed_mass": 0.005},
-    "spray": {"nozzle_position": [0.0, 0.002, 0.01], "nozzle_diameter": 0.002,
-              "spray_zone": {"apex": [0.0, 0.0, 0.01], "half_angle_deg": 30, "y_min": 0.004, "y_max": 0.03}},
-    "dem": {"time_step": 2e-5, "coupling_interval": 5, "settle_time": 0.15, "ramp_time": 0.0, "warmup": 0.01,
-            "sample_rate": 200, "probe_rate": 1000, "sample_duration": 0.05, "reference_duration": 0.03},
-    "probes": [{"name": "bed", "position": [0.0025, 0.0025, 0.0075]}, {"name": "above", "position": [0.0025, 0.08, 0.0075]}],
-    "effects": ["rolling_friction"],
-    "outputs": {"svg": true}
-  })");
-  return s;
-}
+json sceneDocument() { return rcfd::test::demOnlyDatabaseScene(); }
 
 class DatabaseJob : public testing::Test {
  protected:
