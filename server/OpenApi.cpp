@@ -23,13 +23,21 @@ const std::vector<RouteSpec>& routeSpecs() {
       {"get", "/v1/jobs/{id}/artifacts/{name}", "getJobArtifact", "A file the job wrote", 200,
        "application/octet-stream"},
       {"post", "/v1/databases", "uploadDatabase", "Upload a field database (HDF5)", 201, jsonType, "application/x-hdf5"},
+      {"get", "/v1/databases", "listDatabases", "The uploaded databases the caller may use, oldest first", 200,
+       jsonType},
       {"get", "/v1/databases/{id}", "getDatabase", "An uploaded database's record", 200, jsonType},
+      {"get", "/v1/examples", "listExamples", "The example scenes compiled into the server", 200, jsonType},
+      {"get", "/v1/examples/{name}", "getExample", "An example scene", 200, jsonType},
       {"get", "/v1/schemas/{name}", "getSchema", "The JSON Schema of scenes (scene) or jobs (job)", 200,
        "application/schema+json"},
       {"get", "/v1/openapi.json", "getOpenApi", "This document", 200, jsonType},
       {"get", "/v1/health", "getHealth", "Liveness, version and workers (no token)", 200, jsonType, nullptr, nullptr,
        false},
       {"get", "/metrics", "getMetrics", "Prometheus metrics", 200, "text/plain"},
+      {"get", "/", "getWebPage", "The web page of the job service (no token; it asks the API with one)", 200,
+       "text/html", nullptr, nullptr, false},
+      {"get", "/web/{name}", "getWebFile", "A script, style sheet or image of the web page (no token)", 200,
+       "text/javascript", nullptr, nullptr, false},
   };
   return routes;
 }
