@@ -16,7 +16,11 @@ packages=(
   libspdlog-dev          # logging
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
+  chromium               # the web page's browser tests (tests/web), driven headless by playwright-core
 )
+# Node.js and npm run the browser tests (tests/web/package.json); the machine's own Node.js (20) is used
+# where there is one, Debian's otherwise.
+command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

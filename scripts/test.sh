@@ -4,5 +4,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
+# playwright-core for the browser tests of the web page (tests/web), at the version of its lock file.
+npm ci --prefix tests/web --no-audit --no-fund --loglevel=error
 cd build
 ctest --output-on-failure -j "$(nproc)" --timeout 600
