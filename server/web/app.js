@@ -4,7 +4,8 @@
 // text, never parsed as HTML), and the route is the URL's fragment (#/jobs, #/jobs/ID, ...).
 
 import { api, ApiError, download, objectUrl, session, uploadDatabase } from './api.js';
-import { coverageChart, SERIES_COLOURS } from './chart.js';
+import { coverageChart } from './chart.js';
+import { humanDuration } from './format.js';
 
 const FINAL = new Set(['SUCCEEDED', 'FAILED', 'CANCELLED']);
 const PAGE_SIZE = 20;
@@ -24,18 +25,6 @@ function h(tag, attrs = {}, ...children) {
   }
   for (const c of children.flat()) if (c !== undefined && c !== null && c !== false) node.append(c);
   return node;
-}
-
-/// A duration as a person says it: "45 s", "3 min 20 s", "2 h 5 min".
-export function humanDuration(seconds) {
-  if (seconds === null || seconds === undefined || !Number.isFinite(seconds)) return '—';
-  if (seconds < 59.5) return `${Number(seconds.toPrecision(seconds < 10 ? 2 : 3))} s`;
-  if (seconds < 3599.5) {
-    const total = Math.round(seconds), m = Math.floor(total / 60), s = total % 60;
-    return s ? `${m} min ${s} s` : `${m} min`;
-  }
-  const minutes = Math.round(seconds / 60), hrs = Math.floor(minutes / 60), m = minutes % 60;
-  return m ? `${hrs} h ${m} min` : `${hrs} h`;
 }
 
 const shortId = (id) => id.slice(0, 8);

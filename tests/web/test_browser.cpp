@@ -63,7 +63,7 @@ struct NodeRun {
 /// Runs `node script` in tests/web with `env` added, its stdout and stderr together; killed after
 /// `limit` seconds so that a hung browser fails the test instead of hanging the suite.
 NodeRun runNode(const std::string& script, const std::vector<std::string>& env, unsigned limit,
-                const std::filesystem::path& outputFile) {
+                const std::filesystem::path& outputFile, const std::vector<std::string>& moreArgs = {}) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::alarm(limit);
@@ -72,7 +72,9 @@ NodeRun runNode(const std::string& script, const std::vector<std::string>& env, 
     ::dup2(out, 1);
     ::dup2(out, 2);
     if (::chdir(kWebTests.c_str()) != 0) ::_exit(126);
-    execOrExit({"node", script});
+    std::vector<std::string> args = {"node", script};
+    args.insert(args.end(), moreArgs.begin(), moreArgs.end());
+    execOrExit(args);
   }
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -139,6 +141,18 @@ TEST_F(WebBrowser, SignInUploadSubmitWatchDownloadCancelAndValidateInChromium) {
   ASSERT_TRUE(csv) << "the downloaded CSV";
   const std::string saved(std::istreambuf_iterator<char>(csv), {});
   EXPECT_EQ(saved, server->get("/v1/jobs/" + sprayId + "/coverage?format=csv").body);
+}
+
+// The page's number formats and axis ticks (tests/web/format.test.mjs), in node without a browser.
+TEST(WebFormats, TicksAndDurationsOfThePage) {
+  if (onPath("node").empty()) {
+    if (std::getenv("CI")) FAIL() << "node is missing (scripts/install-deps.sh)";
+    GTEST_SKIP() << "node is missing";
+  }
+  TempDir tmp;
+  const NodeRun run = runNode("--test", {}, 60, tmp.path() / "node.log", {"format.test.mjs"});
+  EXPECT_EQ(run.code, 0) << run.output;
+  EXPECT_NE(run.output.find("# pass 2"), std::string::npos) << run.output;
 }
 
 namespace {
