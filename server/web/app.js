@@ -107,8 +107,10 @@ function signInView() {
       await api('/v1/jobs?page_size=1', { token });
       session.signIn(token);
       input.value = '';
-      showNav();
-      location.hash = '#/jobs';
+      // Back to the view the user came for (a job's link), or the job list.
+      const target = location.hash && location.hash !== '#/signin' ? location.hash : '#/jobs';
+      if (location.hash === target) route();
+      else location.hash = target;
     } catch (err) {
       status.append(message(err.status === 401 ? 'The server does not know this token.' : errorText(err), 'error'));
       input.focus();
@@ -420,23 +422,27 @@ const KIND_FIELDS = {
   database: ['f-seed'],
   calibration: ['f-database', 'f-seed', 'f-duration', 'f-discard', 'f-d0-values', 'f-tracers'],
   spray: ['f-database', 'f-seed', 'f-duration', 'f-tracers', 'f-d0', 'f-ensemble'],
-  pipeline: ['f-database', 'f-seed', 'f-duration', 'f-discard', 'f-d0-values', 'f-tracers'],
+  pipeline: ['f-database', 'f-seed', 'f-duration', 'f-calibration-duration', 'f-discard', 'f-d0-values', 'f-tracers'],
 };
 
 function submitView(signal, query) {
   const status = h('div', { class: 'submit-status', 'aria-live': 'polite' });
   const summary = h('div', { id: 'error-summary' });
-  const field = (id, label, input, help) => h('div', { class: 'field', id: `${id}-field` },
-    h('label', { for: id }, label), input,
-    help ? h('p', { class: 'help', id: `${id}-help` }, help) : null,
-    h('p', { class: 'field-error', id: `${id}-error`, hidden: true }));
+  const field = (id, label, input, help) => {
+    const control = input.id === id ? input : input.querySelector(`#${id}`);
+    if (help && control) control.setAttribute('aria-describedby', `${id}-help`);
+    return h('div', { class: 'field', id: `${id}-field` },
+      h('label', { for: id }, label), input,
+      help ? h('p', { class: 'help', id: `${id}-help` }, help) : null,
+      h('p', { class: 'field-error', id: `${id}-error`, hidden: true }));
+  };
   const text = (id, value = '', extra = {}) => h('input', { id, name: id, type: 'text', value, autocomplete: 'off', ...extra });
 
   const source = h('fieldset', { class: 'source' }, h('legend', {}, 'Scene'),
     h('label', {}, h('input', { type: 'radio', name: 'source', value: 'example', checked: true, onchange: sourceChanged }), ' An example scene'),
     h('label', {}, h('input', { type: 'radio', name: 'source', value: 'json', onchange: sourceChanged }), ' Paste or upload a scene or job (JSON)'));
-  const exampleSelect = h('select', { id: 'f-example', 'aria-describedby': 'f-example-help' });
-  const jsonArea = h('textarea', { id: 'f-json', rows: 12, spellcheck: 'false', 'aria-describedby': 'f-json-help' });
+  const exampleSelect = h('select', { id: 'f-example' });
+  const jsonArea = h('textarea', { id: 'f-json', rows: 12, spellcheck: 'false' });
   const fileInput = h('input', { id: 'f-file', type: 'file', accept: '.json,application/json' });
   fileInput.addEventListener('change', async () => { if (fileInput.files[0]) jsonArea.value = await fileInput.files[0].text(); });
   const kindSelect = h('select', { id: 'f-kind', onchange: kindChanged },
@@ -453,7 +459,8 @@ function submitView(signal, query) {
   const fields = h('div', { class: 'grid' },
     field('f-kind', 'Kind', kindSelect),
     field('f-database', 'Database', databaseSelect, 'An uploaded database or a database job (it may still run).'),
-    field('f-duration', 'Duration [s]', text('f-duration', '1', { inputmode: 'decimal' }), 'Simulated time (spray, calibration).'),
+    field('f-duration', 'Duration [s]', text('f-duration', '1', { inputmode: 'decimal' }), 'Simulated time (spray; calibration: per D0 value).'),
+    field('f-calibration-duration', 'Calibration duration [s]', text('f-calibration-duration', '10', { inputmode: 'decimal' }), 'Simulated time per D0 value.'),
     field('f-seed', 'Seed', text('f-seed', '1', { inputmode: 'numeric' })),
     field('f-tracers', 'Tracers', text('f-tracers', '', { inputmode: 'numeric' }), 'Empty: the scene\'s own.'),
     field('f-d0', 'D0 [m²/s]', text('f-d0', '', { inputmode: 'decimal' }), 'Empty: the scene\'s own.'),
@@ -471,7 +478,7 @@ function submitView(signal, query) {
   }
   function kindChanged() {
     const shown = new Set(KIND_FIELDS[kindSelect.value]);
-    for (const id of ['f-database', 'f-duration', 'f-seed', 'f-tracers', 'f-d0', 'f-ensemble', 'f-discard', 'f-d0-values'])
+    for (const id of ['f-database', 'f-duration', 'f-calibration-duration', 'f-seed', 'f-tracers', 'f-d0', 'f-ensemble', 'f-discard', 'f-d0-values'])
       document.getElementById(`${id}-field`).hidden = !shown.has(id);
   }
 
@@ -484,11 +491,11 @@ function submitView(signal, query) {
     }
   }
   /// Shows the violations: each beside the field its pointer maps to, and all of them in a list.
-  function showErrors(title, violations, sceneField) {
+  function showErrors(title, violations, sceneField, fieldOverrides = {}) {
     const items = [];
     let first = null;
     for (const v of violations) {
-      const id = fieldOfPointer(v.pointer, sceneField);
+      const id = v.field ?? fieldOverrides[v.pointer] ?? fieldOfPointer(v.pointer, sceneField);
       const visible = id && !document.getElementById(`${id}-field`).hidden ? id : null;
       if (visible) {
         const p = document.getElementById(`${visible}-error`);
@@ -499,7 +506,7 @@ function submitView(signal, query) {
         input.setAttribute('aria-describedby', `${input.getAttribute('aria-describedby') || ''} ${visible}-error`.trim());
         first ??= input;
       }
-      items.push(h('li', {}, visible ? h('a', { href: `#${visible}`, onclick: (e) => { e.preventDefault(); document.getElementById(visible).focus(); } }, h('code', {}, v.pointer || '/')) : h('code', {}, v.pointer || '/'), `: ${v.message}`));
+      items.push(h('li', {}, visible ? h('a', { href: `#${visible}`, onclick: (e) => { e.preventDefault(); document.getElementById(visible).focus(); } }, h('code', {}, v.pointer || '(the document)')) : h('code', {}, v.pointer || '(the document)'), `: ${v.message}`));
     }
     summary.replaceChildren(h('div', { class: 'message message-error', role: 'alert', tabindex: -1 },
       h('p', {}, title), items.length ? h('ul', { class: 'violations' }, items) : null));
@@ -513,7 +520,7 @@ function submitView(signal, query) {
       return { scene: await api(`/v1/examples/${encodeURIComponent(exampleSelect.value)}`), field: 'f-example' };
     let doc;
     try { doc = JSON.parse(jsonArea.value); }
-    catch (e) { throw Object.assign(new Error('local'), { violations: [{ pointer: '', message: `not JSON: ${e.message}` }] }); }
+    catch (e) { throw Object.assign(new Error('local'), { violations: [{ pointer: '', field: 'f-json', message: `not JSON: ${e.message}` }] }); }
     if (doc && typeof doc === 'object' && !Array.isArray(doc) && 'kind' in doc) return { job: doc, field: 'f-json' };
     return { scene: doc, field: 'f-json' };
   }
@@ -546,11 +553,11 @@ function submitView(signal, query) {
     return job;
   }
 
-  async function submitJob(job, sceneField, what = 'The server refused the job') {
+  async function submitJob(job, sceneField, what = 'The server refused the job', fieldOverrides = {}) {
     try {
       return await api('/v1/jobs', { method: 'POST', json: job });
     } catch (e) {
-      if (e instanceof ApiError && e.status !== 401) showErrors(`${what}: ${e.message}`, e.errors, sceneField);
+      if (e instanceof ApiError && e.status !== 401) showErrors(`${what}: ${e.message}`, e.errors, sceneField, fieldOverrides);
       throw e;
     }
   }
@@ -559,7 +566,11 @@ function submitView(signal, query) {
   /// page waits for the calibration while it stays open.
   async function pipeline(scene, sceneField) {
     const calibrationJob = jobOf('calibration', scene);
-    const calibration = await submitJob(calibrationJob, sceneField, 'The server refused the calibration');
+    const calibrationDuration = numberOrRaw(document.getElementById('f-calibration-duration').value);
+    if (calibrationDuration === undefined) delete calibrationJob.duration;
+    else calibrationJob.duration = calibrationDuration;
+    const calibration = await submitJob(calibrationJob, sceneField, 'The server refused the calibration',
+      { '/duration': 'f-calibration-duration' });
     const line = h('p', {}, 'Calibration ', h('a', { href: `#/jobs/${calibration.id}` }, `job ${shortId(calibration.id)}`), ' submitted; waiting for it ');
     const bar = h('progress', { max: 1, value: 0, 'aria-label': 'calibration progress' });
     status.replaceChildren(line, bar);
