@@ -1,7 +1,7 @@
 // Numbers as a person writes them, shared by the views (and tested in node: tests/web/format.test.mjs).
 
 /// A duration: "45 s", "3 min 20 s", "2 h 5 min"; "—" when there is none. The same forms as the
-/// solver's figure titles (solver/core/AxisTicks.hpp, humanDuration).
+/// solver's figure titles (solver/core/AxisTicks.hpp, durationLabel).
 export function humanDuration(seconds) {
   if (seconds === null || seconds === undefined || !Number.isFinite(seconds)) return '—';
   if (Math.abs(seconds) < 59.5) return `${Number(seconds.toPrecision(3))} s`;

@@ -49,7 +49,7 @@ std::string tickLabel(double value, double step) {
   return s;
 }
 
-std::string humanDuration(double seconds) {
+std::string durationLabel(double seconds) {
   char buf[48];
   if (!std::isfinite(seconds)) return "? s";
   if (std::abs(seconds) < 59.5) {

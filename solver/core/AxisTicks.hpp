@@ -25,9 +25,10 @@ double tickStep(const std::vector<double>& ticks);
 /// "0.15", "20"; exponent form for steps below 1e-4 or from 1e6 on ("2e-05").
 std::string tickLabel(double value, double step);
 
-/// A duration as a person writes it: below a minute in seconds with at most 3 significant digits
+/// A duration as a person writes it in a title (not the fixed-width clock of the progress lines,
+/// jobs/Progress.hpp): below a minute in seconds with at most 3 significant digits
 /// ("2.5 s", "45 s", "0.25 s"); below an hour in minutes and whole seconds ("10 min", "1 min 30 s");
 /// from an hour on in hours and whole minutes ("1 h", "2 h 15 min").
-std::string humanDuration(double seconds);
+std::string durationLabel(double seconds);
 
 }  // namespace rcfd

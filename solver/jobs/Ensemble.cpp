@@ -227,7 +227,7 @@ std::string writeEnsembleCoverageFigure(const json& ensemble, double simTime, co
   const int members = ensemble["members"].get<int>();
   char title[200];
   std::snprintf(title, sizeof title, "Coverage distribution after %s, %d members: median %.3f [%.3f, %.3f]",
-                humanDuration(simTime).c_str(), members, m, mLo, mHi);
+                durationLabel(simTime).c_str(), members, m, mLo, mHi);
   svg.textPx(320, 20, title, 14, "middle");
   svg.textPx(320, 38, "bars: mean over members; orange: 95 % interval of the mean; whiskers: members' range", 11,
              "middle");

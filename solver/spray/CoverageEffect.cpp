@@ -70,7 +70,7 @@ class CoverageEffect final : public TracerEffect {
     svg.axes("surface coverage phi [-] (Eq. 15)", "fraction of particles [-]");
     char median[32];
     std::snprintf(median, sizeof median, "%.3f", d.median);
-    svg.textPx(320, 20, "Coverage distribution after " + humanDuration(ctx.time()) + ", median " + median, 14,
+    svg.textPx(320, 20, "Coverage distribution after " + durationLabel(ctx.time()) + ", median " + median, 14,
                "middle");
     svg.save(outDir + "/coverage.svg");
     return {"coverage.svg"};

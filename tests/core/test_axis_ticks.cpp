@@ -54,15 +54,15 @@ TEST(AxisTicks, RangesOffZeroAndNegativeOnesKeepTheirMultiples) {
 }
 
 TEST(AxisTicks, DurationsReadAsAPersonWritesThem) {
-  EXPECT_EQ(humanDuration(2.5), "2.5 s");
-  EXPECT_EQ(humanDuration(0.25), "0.25 s");
-  EXPECT_EQ(humanDuration(45.0), "45 s");
-  EXPECT_EQ(humanDuration(600.0), "10 min");
-  EXPECT_EQ(humanDuration(600.0000001), "10 min");
-  EXPECT_EQ(humanDuration(90.0), "1 min 30 s");
-  EXPECT_EQ(humanDuration(3600.0), "1 h");
-  EXPECT_EQ(humanDuration(3599.9), "1 h");
-  EXPECT_EQ(humanDuration(8100.0), "2 h 15 min");
+  EXPECT_EQ(durationLabel(2.5), "2.5 s");
+  EXPECT_EQ(durationLabel(0.25), "0.25 s");
+  EXPECT_EQ(durationLabel(45.0), "45 s");
+  EXPECT_EQ(durationLabel(600.0), "10 min");
+  EXPECT_EQ(durationLabel(600.0000001), "10 min");
+  EXPECT_EQ(durationLabel(90.0), "1 min 30 s");
+  EXPECT_EQ(durationLabel(3600.0), "1 h");
+  EXPECT_EQ(durationLabel(3599.9), "1 h");
+  EXPECT_EQ(durationLabel(8100.0), "2 h 15 min");
 }
 
 TEST(AxisTicks, FigureAxesCarryTheRoundTicks) {
