@@ -37,7 +37,7 @@ StringResponse webFile(const Target& target) {
     return problem(http::status::not_found, "web-file-not-found", "Not found",
                    "the web page has no file \"" + name + "\"", target.path);
   auto res = textResponse(http::status::ok, std::string(it->second), mediaType(name));
-  res.set("Content-Security-Policy", kWebContentSecurityPolicy);
+  res.set("Content-Security-Policy", std::string(kWebContentSecurityPolicy));
   res.set("X-Content-Type-Options", "nosniff");
   res.set("Referrer-Policy", "no-referrer");
   res.set("Cross-Origin-Opener-Policy", "same-origin");
