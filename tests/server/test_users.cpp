@@ -248,7 +248,8 @@ TEST_F(Users, ADatabaseIsItsUploadersAndOnlyTheyAndAdminsCanUseIt) {
     std::vector<std::string> ids;
     const auto r = get(user, "/v1/databases");
     EXPECT_EQ(r.status, 200) << r.body;
-    for (const auto& d : r.json().at("databases")) ids.push_back(d.at("id"));
+    const nlohmann::json body = r.json();
+    for (const auto& d : body.at("databases")) ids.push_back(d.at("id"));
     return ids;
   };
   EXPECT_EQ(listed("alice"), std::vector<std::string>{db});

@@ -105,13 +105,15 @@ TEST_F(WebPage, EveryFileOfThePageIsServedWithItsMediaTypeAndHeaders) {
 }
 
 TEST_F(WebPage, NamesOutsideThePageAreNotFoundAndOtherMethodsNeedTheToken) {
-  for (const std::string& target : {"/web/nope.js", "/web/%2e%2e%2frcfd.sqlite", "/web/token", "/web/rcfd.sqlite",
+  for (const char* target : {"/web/nope.js", "/web/%2e%2e%2frcfd.sqlite", "/web/token", "/web/rcfd.sqlite",
                                     "/web/index.html.bak", "/web/APP.JS"}) {
     const Reply r = anonymous(http::verb::get, target);
     EXPECT_EQ(r.status, 404) << target;
     EXPECT_EQ(r.header("content-type"), "application/problem+json") << target;
   }
-  EXPECT_EQ(anonymous(http::verb::get, "/web/../rcfd.sqlite").status, 400);
+  // A path that leaves /web/ is not the page's: without the token 401, with it 400 (no . or .. segments).
+  EXPECT_EQ(anonymous(http::verb::get, "/web/../rcfd.sqlite").status, 401);
+  EXPECT_EQ(httpRequest(server_->port(), http::verb::get, "/web/../rcfd.sqlite", kToken).status, 400);
   // Only GET of the page's own paths is public: a folder, another method, a deeper path need the token.
   for (const auto& [method, target] : std::vector<std::pair<http::verb, std::string>>{
            {http::verb::get, "/web/"}, {http::verb::get, "/web/x/app.js"}, {http::verb::get, "//"},
@@ -148,7 +150,8 @@ TEST_F(WebPage, TheExamplesAreTheRepositorysScenes) {
   const Reply list = httpRequest(server_->port(), http::verb::get, "/v1/examples", kToken);
   ASSERT_EQ(list.status, 200) << list.body;
   std::set<std::string> names;
-  for (const auto& e : list.json().at("examples")) {
+  const nlohmann::json examples = list.json();
+  for (const auto& e : examples.at("examples")) {
     names.insert(e.at("name").get<std::string>());
     EXPECT_FALSE(e.at("description").get<std::string>().empty()) << e.dump();
   }
