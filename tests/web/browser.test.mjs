@@ -2,7 +2,7 @@
 // tests/web/test_browser.cpp, which passes its address, token and a small field database in RCFD_WEB_*):
 // sign in, upload the database with a progress bar, submit a small spray job on it, watch it finish, see
 // its coverage plot and figures, download the coverage CSV, cancel a second job, see a validation error
-// beside its field, and read the job list at a phone's width.
+// beside its field, read the job list at a phone's width, and chain a calibration and a spray job.
 import assert from 'node:assert/strict';
 import { writeFileSync } from 'node:fs';
 import { join } from 'node:path';
@@ -138,6 +138,23 @@ test('the job list shows kind, state, progress and ETA, also at a phone\'s width
   const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
   assert.ok(overflow <= 0, `no horizontal scrolling at 390 px (${overflow} px too wide)`);
   await page.setViewportSize({ width: 1280, height: 800 });
+});
+
+test('calibration, then spray: the page submits the spray job with the D0 the calibration selected', async () => {
+  await page.goto(`${url}/#/submit?database=${databaseId}`);
+  await page.getByLabel('Kind', { exact: true }).selectOption('pipeline');
+  await page.locator(`#f-database option[value="${databaseId}"]`).waitFor({ state: 'attached' });
+  await page.getByLabel('Database', { exact: true }).selectOption(databaseId);
+  await page.getByLabel('Duration [s]', { exact: true }).fill('0.25');
+  await page.getByLabel('Calibration duration [s]', { exact: true }).fill('0.25');
+  await page.getByLabel('Discard [s]', { exact: true }).fill('0');
+  await page.getByLabel('D0 values [m²/s]', { exact: true }).fill('0, 1e-4');
+  await page.getByLabel('Tracers', { exact: true }).fill('200');
+  await page.getByRole('button', { name: 'Submit' }).click();
+  const done = page.getByText(/The calibration selected D0 = \S+ m²\/s; spray/);
+  await done.waitFor({ timeout: 180_000 });
+  const link = done.getByRole('link');
+  assert.match(await link.getAttribute('href'), /^#\/jobs\/[0-9a-f]{32}$/);
 });
 
 test('no uncaught error and no Content-Security-Policy violation happened', () => {

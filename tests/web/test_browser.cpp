@@ -108,7 +108,7 @@ class WebBrowser : public ::testing::Test {
 
 }  // namespace
 
-TEST_F(WebBrowser, SignInUploadSubmitWatchDownloadCancelAndValidateInChromium) {
+TEST_F(WebBrowser, SignInUploadSubmitWatchDownloadCancelValidateAndChainInChromium) {
   const auto database = tmp_->path() / "db.h5";
   writeSmallDatabase(quickScene(), database);
   const auto server = start();
@@ -127,10 +127,18 @@ TEST_F(WebBrowser, SignInUploadSubmitWatchDownloadCancelAndValidateInChromium) {
   idFile >> sprayId;
   ASSERT_EQ(sprayId.size(), 32u);
   const auto jobs = server->get("/v1/jobs").json().at("jobs");
-  ASSERT_EQ(jobs.size(), 2u) << jobs.dump(2);
+  ASSERT_EQ(jobs.size(), 4u) << jobs.dump(2);
   EXPECT_EQ(jobs[0].at("id"), sprayId);
   EXPECT_EQ(jobs[0].at("state"), "SUCCEEDED");
   EXPECT_EQ(jobs[1].at("state"), "CANCELLED");
+  // The chain: a calibration, then a spray job with the D0 it selected.
+  EXPECT_EQ(jobs[2].at("kind"), "calibration");
+  EXPECT_EQ(jobs[2].at("state"), "SUCCEEDED");
+  EXPECT_EQ(jobs[3].at("kind"), "spray");
+  const auto selected = server->get("/v1/jobs/" + jobs[2].at("id").get<std::string>() + "/result").json().at("selected_d0");
+  const auto chained = server->get("/v1/jobs/" + jobs[3].at("id").get<std::string>() + "?view=full").json();
+  EXPECT_EQ(chained.at("request").at("scene").at("rcfd").at("d0"), selected);
+  EXPECT_EQ(chained.at("request").at("database"), jobs[0].at("database"));
   const auto uploads = server->get("/v1/databases").json().at("databases");
   ASSERT_EQ(uploads.size(), 1u);
   EXPECT_EQ(jobs[0].at("database"), uploads[0].at("id"));
