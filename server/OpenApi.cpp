@@ -33,11 +33,11 @@ const std::vector<RouteSpec>& routeSpecs() {
       {"get", "/v1/openapi.json", "getOpenApi", "This document", 200, jsonType},
       {"get", "/v1/health", "getHealth", "Liveness, version and workers (no token)", 200, jsonType, nullptr, nullptr,
        false},
-      {"get", "/metrics", "getMetrics", "Prometheus metrics", 200, "text/plain"},
       {"get", "/", "getWebPage", "The web page of the job service (no token; it asks the API with one)", 200,
        "text/html", nullptr, nullptr, false},
       {"get", "/web/{name}", "getWebFile", "A script, style sheet or image of the web page (no token)", 200,
        "text/javascript", nullptr, nullptr, false},
+      {"get", "/metrics", "getMetrics", "Prometheus metrics", 200, "text/plain"},
   };
   return routes;
 }
