@@ -1,7 +1,7 @@
 // The web page in a real browser against a real rcfd-server on loopback (started by
 // tests/web/test_browser.cpp, which passes its address, token and a small field database in RCFD_WEB_*):
-// sign in, upload the database with a progress bar, submit a small spray job on it, watch it finish, see
-// its coverage plot and figures, download the coverage CSV, cancel a second job, see a validation error
+// sign in, upload the database with a progress bar, submit a small spray job (two ensemble members) on it, watch it finish, see
+// its coverage plot with the ensemble band and its figures, download the coverage CSV, cancel a second job, see a validation error
 // beside its field, read the job list at a phone's width, and chain a calibration and a spray job.
 import assert from 'node:assert/strict';
 import { writeFileSync } from 'node:fs';
@@ -52,7 +52,7 @@ test('a database uploads with a progress bar and is listed', async () => {
   assert.match(databaseId, /^[0-9a-f]{32}$/);
 });
 
-async function submitSpray(duration) {
+async function submitSpray(duration, ensemble = '') {
   await page.goto(`${url}/#/submit?database=${databaseId}`);
   await page.getByLabel('Example scene', { exact: true }).selectOption('quick');
   await page.getByLabel('Kind', { exact: true }).selectOption('spray');
@@ -60,18 +60,20 @@ async function submitSpray(duration) {
   await page.getByLabel('Database', { exact: true }).selectOption(databaseId);
   await page.getByLabel('Duration [s]', { exact: true }).fill(String(duration));
   await page.getByLabel('Tracers', { exact: true }).fill('200');
+  await page.getByLabel('Ensemble members', { exact: true }).fill(ensemble);
   await page.getByRole('button', { name: 'Submit' }).click();
   await page.waitForURL(/#\/jobs\/[0-9a-f]{32}$/);
   return page.url().split('/').pop();
 }
 
-test('a small spray job submitted from an example scene finishes and shows its coverage', async () => {
-  sprayId = await submitSpray(0.25);
+test('a small spray job with two ensemble members finishes and shows its coverage with the band', async () => {
+  sprayId = await submitSpray(0.25, '2');
   await page.getByRole('heading', { name: /^Spray job/ }).waitFor();
   await page.locator('.state', { hasText: 'SUCCEEDED' }).waitFor({ timeout: 180_000 });
   const chart = page.locator('section.coverage svg.chart');
   await chart.waitFor();
   assert.ok(await chart.locator('rect.bar').count() >= 10, 'a bar per coverage bin');
+  assert.equal(await chart.locator('rect.band').count(), await chart.locator('rect.bar').count(), 'the ensemble band');
   const yTicks = await chart.locator('text.tick-y').allTextContents();
   for (const t of yTicks) assert.match(t, /^\d+(\.\d*[05]?)?$|^0$/, `round tick ${t}`);
   const stats = page.locator('table.stats tbody tr');

@@ -145,6 +145,7 @@ TEST_F(WebBrowser, SignInUploadSubmitWatchDownloadCancelValidateAndChainInChromi
   const auto request = server->get("/v1/jobs/" + sprayId + "?view=full").json().at("request");
   EXPECT_EQ(request.at("scene").at("rcfd").at("tracers"), 200);
   EXPECT_EQ(request.at("duration"), 0.25);
+  EXPECT_EQ(request.at("ensemble"), 2);
   std::ifstream csv(downloads / ("coverage-" + sprayId.substr(0, 8) + ".csv"));
   ASSERT_TRUE(csv) << "the downloaded CSV";
   const std::string saved(std::istreambuf_iterator<char>(csv), {});
