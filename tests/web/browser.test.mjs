@@ -1,8 +1,9 @@
 // The web page in a real browser against a real rcfd-server on loopback (started by
 // tests/web/test_browser.cpp, which passes its address, token and a small field database in RCFD_WEB_*):
-// sign in, upload the database with a progress bar, submit a small spray job (two ensemble members) on it, watch it finish, see
-// its coverage plot with the ensemble band and its figures, download the coverage CSV, cancel a second job, see a validation error
-// beside its field, read the job list at a phone's width, and chain a calibration and a spray job.
+// sign in, upload the database with a progress bar, submit a small spray job (two ensemble members) on
+// it, watch it finish, see its coverage plot with the ensemble band and its figures, download the
+// coverage CSV, cancel a second job, see a validation error beside its field, read the job list at a
+// phone's width, and chain a calibration and a spray job.
 import assert from 'node:assert/strict';
 import { writeFileSync } from 'node:fs';
 import { join } from 'node:path';
