@@ -16,11 +16,14 @@ packages=(
   libspdlog-dev          # logging
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
-  chromium               # the web page's browser tests (tests/web), driven headless by playwright-core
 )
-# Node.js and npm run the browser tests (tests/web/package.json); the machine's own Node.js (20) is used
-# where there is one, Debian's otherwise.
-command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
+# The browser tests of the web page (tests/web): chromium, driven headless by playwright-core from
+# Node.js and npm (tests/web/package.json); the machine's own Node.js (20) is used where there is one,
+# Debian's otherwise. RCFD_DEPS_NO_BROWSER=1 leaves them out (docker/Dockerfile builds without tests).
+if [ "${RCFD_DEPS_NO_BROWSER:-0}" != 1 ]; then
+  packages+=(chromium)
+  command -v node >/dev/null && command -v npm >/dev/null || packages+=(nodejs npm)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
