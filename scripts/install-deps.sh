@@ -1,16 +1,13 @@
 #!/usr/bin/env bash
 # Installs rcfd's build and test dependencies from Debian 12 packages (run as root, or with sudo).
 # Every dependency of the project is named here; docker/Dockerfile installs the same list.
-#   --without-paraview  leaves out ParaView, which only the ParaView check of the tests uses (the image
-#                       of docker/Dockerfile builds without tests)
+#   --build-only  leaves out the tools only the tests use (ParaView, Chromium, Node.js; the image of
+#                 docker/Dockerfile builds without tests)
 set -euo pipefail
-# The XDMF sidecars of the HDF5 outputs must open in ParaView: scripts/check-paraview.py opens them with
-# ParaView's own reader (pvpython) and reads the HDF5 files independently with h5py
-# (test ParaView.OpensEveryJobOutputThroughItsSidecar).
-paraview_packages=(paraview python3-paraview python3-h5py python3-numpy)
+test_tools=1
 for arg in "$@"; do
   case "$arg" in
-    --without-paraview) paraview_packages=() ;;
+    --build-only) test_tools=0 ;;
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done
@@ -29,11 +26,20 @@ packages=(
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
 )
-# Node.js and npm run the OpenAPI meta-schema validator (tests/openapi); a Node.js from elsewhere that
-# brings its own npm is kept.
-command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)
+if [ "$test_tools" = 1 ]; then
+  # The XDMF sidecars of the HDF5 outputs must open in ParaView: scripts/check-paraview.py opens them
+  # with ParaView's own reader (pvpython) and reads the HDF5 files independently with h5py
+  # (test ParaView.OpensEveryJobOutputThroughItsSidecar).
+  packages+=(paraview python3-paraview python3-h5py python3-numpy)
+  # The browser tests of the web page (tests/web): chromium, driven headless by playwright-core from
+  # Node.js and npm (tests/web/package.json), which also run the OpenAPI meta-schema validator
+  # (tests/openapi). The machine's own Node.js (20) with its npm is kept where there is one; Debian's
+  # otherwise.
+  packages+=(chromium)
+  command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)
+fi
 missing=()
-for p in "${packages[@]}" "${paraview_packages[@]}"; do
+for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then

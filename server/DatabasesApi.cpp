@@ -202,4 +202,11 @@ Response DatabasesApi::get(const std::string& id, const Target& target, const Ca
   return jsonResponse(http::status::ok, toJson(*db));
 }
 
+Response DatabasesApi::list(const Caller& caller) {
+  nlohmann::json items = nlohmann::json::array();
+  for (const DatabaseRecord& db : store_.listDatabases(caller.admin ? std::string() : caller.name))
+    items.push_back(toJson(db));
+  return jsonResponse(http::status::ok, {{"databases", std::move(items)}});
+}
+
 }  // namespace rcfd::server

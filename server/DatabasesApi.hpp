@@ -4,7 +4,8 @@
 /// to a temporary file by HttpSession, validated with rcfd::FieldDatabase::open in a child
 /// process (HDF5 can crash or loop on a damaged file: only the child goes, killed after
 /// --upload-check-timeout) and only then kept under DIR/databases/<id>.h5. GET /v1/databases/{id}
-/// describes one to its uploader or an admin (to anyone else it does not exist: 404).
+/// describes one to its uploader or an admin (to anyone else it does not exist: 404); GET /v1/databases
+/// lists them to the same readers.
 
 #include <filesystem>
 #include <string_view>
@@ -35,6 +36,8 @@ class DatabasesApi {
   /// waits for the validating child; call it off the io_context threads.
   StringResponse accept(const std::filesystem::path& file, const Target& target, const Caller& caller);
   Response get(const std::string& id, const Target& target, const Caller& caller);
+  /// GET /v1/databases: the caller's uploads (an admin's: everyone's), oldest first.
+  Response list(const Caller& caller);
 
  private:
   JobStore& store_;

@@ -528,6 +528,26 @@ std::optional<DatabaseRecord> JobStore::database(const std::string& id) {
   return d;
 }
 
+std::vector<DatabaseRecord> JobStore::listDatabases(const std::string& owner) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "SELECT id, path, bytes, frames, created_at, owner FROM databases WHERE ?1 = '' OR owner = ?1 "
+              "ORDER BY rowid");
+  s.bind(1, owner);
+  std::vector<DatabaseRecord> out;
+  while (s.step()) {
+    DatabaseRecord d;
+    d.id = s.text(0);
+    d.path = s.text(1);
+    d.bytes = s.integer(2);
+    d.frames = static_cast<int>(s.integer(3));
+    d.createdAt = s.text(4);
+    d.owner = s.text(5);
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 std::vector<std::pair<std::string, std::int64_t>> JobStore::countByState() {
   std::vector<std::pair<std::string, std::int64_t>> out;
   for (const char* s : {state::queued, state::running, state::succeeded, state::failed,

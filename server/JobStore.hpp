@@ -126,6 +126,8 @@ class JobStore {
 
   void insertDatabase(const DatabaseRecord& db);
   std::optional<DatabaseRecord> database(const std::string& id);
+  /// The uploaded databases of `owner` (empty: everyone's), oldest first.
+  std::vector<DatabaseRecord> listDatabases(const std::string& owner);
 
   /// Number of jobs in each state (every state present, zero if none).
   std::vector<std::pair<std::string, std::int64_t>> countByState();

@@ -1,8 +1,10 @@
 #include "Router.hpp"
 
+#include "ExamplesApi.hpp"
 #include "Ids.hpp"
 #include "OpenApi.hpp"
 #include "Problem.hpp"
+#include "WebPage.hpp"
 #include "WorkerPool.hpp"
 #include "scene/SceneLoader.hpp"
 
@@ -35,7 +37,8 @@ Router::Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const Server
 
 bool Router::isPublic(http::verb method, std::string_view target) {
   const auto path = target.substr(0, target.find('?'));
-  return method == http::verb::get && (path == "/v1/health" || path == "/v1/health/");
+  // The web page's files hold no data (WebPage.hpp); everything the page shows comes from the API.
+  return method == http::verb::get && (path == "/v1/health" || path == "/v1/health/" || isWebPath(path));
 }
 
 bool Router::isUpload(http::verb method, std::string_view target) {
@@ -93,6 +96,10 @@ Response Router::route(const Request& req, const Target& target, const std::opti
     return textResponse(http::status::ok, metrics_.render(store_, pool_.busy(), pool_.slots()),
                         "text/plain; version=0.0.4; charset=utf-8");
   }
+  if (isWebPath(target.path)) {
+    if (!get) return methodNotAllowed(target, "GET");
+    return webFile(target);
+  }
   if (s.empty() || s[0] != "v1") return noRoute(target);
 
   if (s.size() == 2 && s[1] == "health") {
@@ -103,7 +110,7 @@ Response Router::route(const Request& req, const Target& target, const std::opti
                                            {"workers", pool_.slots()},
                                            {"workers_busy", pool_.busy()}});
   }
-  // Only health is public (handle() answered 401 for anything else without a caller).
+  // Only health and the page are public (handle() answered 401 for anything else without a caller).
   if (!caller) return unauthorized(target.path);
   const Caller& who = *caller;
   if (s.size() == 2 && s[1] == "openapi.json") {
@@ -120,8 +127,16 @@ Response Router::route(const Request& req, const Target& target, const std::opti
                      "no schema \"" + s[2] + "\"; available: scene, job", target.path);
     }
   }
+  if (s.size() >= 2 && s[1] == "examples") {
+    if (s.size() > 3) return noRoute(target);
+    if (!get) return methodNotAllowed(target, "GET");
+    return s.size() == 2 ? listExamples() : getExample(s[2], target);
+  }
   if (s.size() >= 2 && s[1] == "databases") {
-    if (s.size() == 2) return methodNotAllowed(target, "POST");  // uploads are routed by the session
+    if (s.size() == 2) {
+      if (get) return databases_.list(who);
+      return methodNotAllowed(target, "GET, POST");  // uploads are routed by the session
+    }
     if (s.size() == 3) {
       if (!get) return methodNotAllowed(target, "GET");
       return databases_.get(s[2], target, who);

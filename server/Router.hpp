@@ -1,8 +1,9 @@
 #pragma once
 /// \file Router.hpp
 /// Maps a request to its handler (REST shape: docs/contracts.md, "HTTP API"), authenticates its caller
-/// by the bearer token (everything but GET /v1/health needs one; ServerConfig::users says whose it is)
-/// and answers health, schema and metrics requests itself. Job and database handlers get the caller:
+/// by the bearer token (everything but GET /v1/health and the web page's files needs one;
+/// ServerConfig::users says whose it is) and answers health, schema, example, page and metrics requests
+/// itself. Job and database handlers get the caller:
 /// what is whose is decided there.
 
 #include "DatabasesApi.hpp"

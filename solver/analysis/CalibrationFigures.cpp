@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/AxisTicks.hpp"
 #include "core/Svg.hpp"
 
 namespace rcfd::analysis {
@@ -65,12 +66,10 @@ std::string probeFigure(const CalibrationFigureData& d, const std::string& dir) 
   SvgDocument svg(tmin, tmax, 0.0, span * double(n) - 0.25, 640, 110.0 * double(n) + 60, 55);
   // Time axis only: the y extent holds one panel per D0.
   svg.rect(tmin, 0.0, tmax, span * double(n) - 0.25, "none", "#000", 1.0);
-  for (int k = 0; k <= 5; ++k) {
-    const double t = tmin + (tmax - tmin) * k / 5.0;
-    char label[32];
-    std::snprintf(label, sizeof label, "%.3g", t);
+  const std::vector<double> ticks = niceTicks(tmin, tmax, 5);
+  for (const double t : ticks) {
     svg.line(t, 0.0, t, -0.05);
-    svg.textPx(svg.px(t), svg.py(0.0) + 17, label, 10, "middle");
+    svg.textPx(svg.px(t), svg.py(0.0) + 17, tickLabel(t, tickStep(ticks)), 10, "middle");
   }
   svg.textPx((svg.px(tmin) + svg.px(tmax)) / 2, 110.0 * double(n) + 55, "t [s]; probe " + d.probeName, 12, "middle");
   for (std::size_t r = 0; r < n; ++r) {

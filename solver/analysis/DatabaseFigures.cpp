@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "analysis/CalibrationReport.hpp"
+#include "core/AxisTicks.hpp"
 #include "core/Errors.hpp"
 #include "core/Svg.hpp"
 #include "geometry/Apparatus.hpp"
@@ -96,12 +97,6 @@ std::string alphaFigure(const Scene& scene, const FieldDatabase& db, const std::
   return name;
 }
 
-/// 1, 2 or 5 times a power of ten, close to `raw` (axis ticks on round numbers).
-double niceStep(double raw) {
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  const double f = raw / p;
-  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
-}
 
 std::string pressureFigure(const PressureDropSeries& p, const std::string& dir) {
   constexpr int kTicks = 6;

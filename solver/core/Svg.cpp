@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/AxisTicks.hpp"
 #include "core/Errors.hpp"
 
 namespace rcfd {
@@ -28,11 +29,6 @@ std::string escape(const std::string& s) {
     }
   }
   return out;
-}
-std::string tickLabel(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
 }
 }  // namespace
 
@@ -241,17 +237,17 @@ void SvgDocument::heatmapImage(const std::vector<double>& values, int nx, int ny
 
 void SvgDocument::axes(const std::string& xlabel, const std::string& ylabel, int xticks, int yticks) {
   rect(xmin_, ymin_, xmax_, ymax_, "none", "#000", 1.0);
-  for (int i = 0; i <= xticks; ++i) {
-    const double x = xmin_ + (xmax_ - xmin_) * i / xticks;
+  const std::vector<double> xs = niceTicks(std::min(xmin_, xmax_), std::max(xmin_, xmax_), xticks);
+  for (const double x : xs) {
     body_ += "<line x1=\"" + num(px(x)) + "\" y1=\"" + num(py(ymin_)) + "\" x2=\"" + num(px(x)) +
              "\" y2=\"" + num(py(ymin_) + 5) + "\" stroke=\"#000\"/>\n";
-    textPx(px(x), py(ymin_) + 17, tickLabel(x), 10, "middle");
+    textPx(px(x), py(ymin_) + 17, tickLabel(x, tickStep(xs)), 10, "middle");
   }
-  for (int i = 0; i <= yticks; ++i) {
-    const double y = ymin_ + (ymax_ - ymin_) * i / yticks;
+  const std::vector<double> ys = niceTicks(std::min(ymin_, ymax_), std::max(ymin_, ymax_), yticks);
+  for (const double y : ys) {
     body_ += "<line x1=\"" + num(px(xmin_) - 5) + "\" y1=\"" + num(py(y)) + "\" x2=\"" +
              num(px(xmin_)) + "\" y2=\"" + num(py(y)) + "\" stroke=\"#000\"/>\n";
-    textPx(px(xmin_) - 7, py(y) + 3, tickLabel(y), 10, "end");
+    textPx(px(xmin_) - 7, py(y) + 3, tickLabel(y, tickStep(ys)), 10, "end");
   }
   textPx((px(xmin_) + px(xmax_)) / 2, height_ - 5, xlabel, 12, "middle");
   body_ += "<text transform=\"translate(12," + num((py(ymin_) + py(ymax_)) / 2) +

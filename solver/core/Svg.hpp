@@ -51,7 +51,8 @@ class SvgDocument {
   /// one PNG image (uncompressed, base64), a fraction of the size of one <rect> per cell. NaN: white.
   void heatmapImage(const std::vector<double>& values, int nx, int ny, double x0, double x1, double y0,
                     double y1);
-  /// Axis box with ticks and labels along the plot area's edges.
+  /// Axis box with ticks and labels along the plot area's edges: at round numbers (niceTicks(), about
+  /// `xticks` and `yticks` intervals), labelled with the decimals their step needs.
   void axes(const std::string& xlabel, const std::string& ylabel, int xticks = 5, int yticks = 5);
 
   std::string str() const;

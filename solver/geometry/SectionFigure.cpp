@@ -5,6 +5,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/AxisTicks.hpp"
 #include "geometry/Apparatus.hpp"
 #include "geometry/SprayZone.hpp"
 
@@ -36,12 +37,6 @@ std::string fmt(double v, int precision = 4) {
   return s.str();
 }
 
-/// 1, 2 or 5 times a power of ten, close to `raw`.
-double niceStep(double raw) {
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  const double f = raw / p;
-  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * p;
-}
 
 /// Where a drawing goes: the part of the section inside [lo, hi] (scene coordinates), scaled by `zoom`
 /// about `lo` and placed at `at` (user coordinates of the document). The main view is the identity.

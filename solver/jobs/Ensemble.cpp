@@ -5,6 +5,7 @@
 #include <set>
 
 #include "analysis/EnsembleStatistics.hpp"
+#include "core/AxisTicks.hpp"
 #include "core/Errors.hpp"
 #include "core/Svg.hpp"
 
@@ -225,8 +226,8 @@ std::string writeEnsembleCoverageFigure(const json& ensemble, double simTime, co
   svg.axes("surface coverage phi [-] (Eq. 15)", "fraction of particles [-]");
   const int members = ensemble["members"].get<int>();
   char title[200];
-  std::snprintf(title, sizeof title, "Coverage distribution after %g s, %d members: median %.3f [%.3f, %.3f]", simTime,
-                members, m, mLo, mHi);
+  std::snprintf(title, sizeof title, "Coverage distribution after %s, %d members: median %.3f [%.3f, %.3f]",
+                durationLabel(simTime).c_str(), members, m, mLo, mHi);
   svg.textPx(320, 20, title, 14, "middle");
   svg.textPx(320, 38, "bars: mean over members; orange: 95 % interval of the mean; whiskers: members' range", 11,
              "middle");

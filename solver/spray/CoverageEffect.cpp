@@ -1,7 +1,9 @@
 // coverage: Eq. (15) per tracer from the droplets it collected per real particle, and the coverage
 // distribution over the bed (the paper's Fig. 12).
+#include <cstdio>
 #include <memory>
 
+#include "core/AxisTicks.hpp"
 #include "core/Svg.hpp"
 #include "spray/Coverage.hpp"
 #include "spray/SprayState.hpp"
@@ -66,9 +68,10 @@ class CoverageEffect final : public TracerEffect {
     }
     svg.line(d.median, 0.0, d.median, top, "#c00", 1.5, "5,3");
     svg.axes("surface coverage phi [-] (Eq. 15)", "fraction of particles [-]");
-    svg.textPx(320, 20, "Coverage distribution after " + std::to_string(ctx.time()) + " s, median " +
-                            std::to_string(d.median).substr(0, 5),
-               14, "middle");
+    char median[32];
+    std::snprintf(median, sizeof median, "%.3f", d.median);
+    svg.textPx(320, 20, "Coverage distribution after " + durationLabel(ctx.time()) + ", median " + median, 14,
+               "middle");
     svg.save(outDir + "/coverage.svg");
     return {"coverage.svg"};
   }

@@ -243,6 +243,18 @@ TEST_F(Users, ADatabaseIsItsUploadersAndOnlyTheyAndAdminsCanUseIt) {
 
   expectNotFound(get("bob", "/v1/databases/" + db), "bob's look at alice's upload");
   EXPECT_EQ(get("root", "/v1/databases/" + db).json().at("owner"), "alice");
+  // The listing of uploads follows the same rule: hers to her and to admins, nothing to bob.
+  const auto listed = [&](const std::string& user) {
+    std::vector<std::string> ids;
+    const auto r = get(user, "/v1/databases");
+    EXPECT_EQ(r.status, 200) << r.body;
+    const nlohmann::json body = r.json();
+    for (const auto& d : body.at("databases")) ids.push_back(d.at("id"));
+    return ids;
+  };
+  EXPECT_EQ(listed("alice"), std::vector<std::string>{db});
+  EXPECT_EQ(listed("root"), std::vector<std::string>{db});
+  EXPECT_TRUE(listed("bob").empty());
   const auto spray = [&](const std::string& database) {
     return nlohmann::json{{"kind", "spray"}, {"scene", quickScene()}, {"database", database}, {"duration", 1.0}};
   };
