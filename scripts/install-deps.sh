@@ -16,6 +16,8 @@ packages=(
   libspdlog-dev          # logging
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
+  slurm-wlm munge        # rcfd-server --executor slurm: sbatch/squeue/scancel, and the single-node test
+                         # cluster of tests/slurm (slurmctld, slurmd, munged)
 )
 # Node.js and npm run the OpenAPI meta-schema validator (tests/openapi); a Node.js from elsewhere that
 # brings its own npm is kept.
