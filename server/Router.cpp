@@ -3,7 +3,7 @@
 #include "Ids.hpp"
 #include "OpenApi.hpp"
 #include "Problem.hpp"
-#include "WorkerPool.hpp"
+#include "JobExecutor.hpp"
 #include "scene/SceneLoader.hpp"
 
 namespace rcfd::server {
@@ -25,7 +25,7 @@ StringResponse noRoute(const Target& target) {
 }
 }  // namespace
 
-Router::Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const ServerConfig& config)
+Router::Router(JobStore& store, JobExecutor& pool, Metrics& metrics, const ServerConfig& config)
     : store_(store),
       pool_(pool),
       metrics_(metrics),
