@@ -342,11 +342,11 @@ void SlurmExecutor::submit(const JobRecord& job) {
                                    "--chdir=" + dir.string(),
                                    "--ntasks=1",
                                    "--cpus-per-task=" + std::to_string(slurm.cpusPerJob),
-                                   "--signal=B:TERM@" + std::to_string(slurm.signalLead.count()),
                                    // Requeues are the server's: Slurm's own would rerun a job the server
                                    // has already ended, under the same id.
                                    "--no-requeue",
                                    "--open-mode=append"};
+  if (slurm.signalLead.count() > 0) args.push_back("--signal=B:TERM@" + std::to_string(slurm.signalLead.count()));
   if (!slurm.partition.empty()) args.push_back("--partition=" + slurm.partition);
   if (!slurm.account.empty()) args.push_back("--account=" + slurm.account);
   if (auto it = slurm.timeLimits.find(job.kind); it != slurm.timeLimits.end()) args.push_back("--time=" + it->second);

@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
                  "times a job Slurm ends by TIMEOUT, NODE_FAIL or PREEMPTED is submitted again to resume from its checkpoint")
       ->capture_default_str()->check(CLI::Range(0, 100));
   app.add_option("--slurm-signal-lead", slurmLead,
-                 "seconds before the time limit at which Slurm sends SIGTERM, so that the solver checkpoints")
+                 "seconds before the time limit at which Slurm sends SIGTERM, so that the solver checkpoints (0: none)")
       ->capture_default_str()->check(CLI::Range(0, 65535));
   app.add_option("--slurm-max-jobs", config.slurm.maxJobs, "jobs in Slurm at once; more wait QUEUED in the server")
       ->capture_default_str()->check(CLI::Range(1, 1000000));
