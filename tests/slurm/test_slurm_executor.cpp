@@ -103,7 +103,8 @@ bool isFinal(const nlohmann::json& job) {
 /// The reasons of the job's events, one a line, for messages and searches.
 std::string eventReasons(const ServerProcess& server, const std::string& id) {
   std::string out;
-  for (const auto& e : server.get("/v1/jobs/" + id + "/events").json().at("events")) {
+  const auto events = server.get("/v1/jobs/" + id + "/events").json();  // not a temporary in the for
+  for (const auto& e : events.at("events")) {
     out += e.at("from").is_null() ? std::string("-") : e.at("from").get<std::string>();
     out += " -> " + e.at("to").get<std::string>() + ": " + e.at("reason").get<std::string>() + "\n";
   }
@@ -186,10 +187,20 @@ class SlurmExecutor : public ::testing::Test {
   /// The job's solver once it has written its first checkpoint, frozen with SIGSTOP so that the job is
   /// still running whatever the machine's speed; -1 if none was seen in time.
   pid_t frozenSolverWithCheckpoint(const std::string& id) {
-    for (int i = 0; i < 1200; ++i) {
-      const pid_t solver = solverIn(jobDir(id));
-      if (solver > 0 && fs::exists(jobDir(id) / "checkpoint.h5") && ::kill(solver, SIGSTOP) == 0) return solver;
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(90);
+    pid_t solver = -1;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (solver < 0) {
+        solver = solverIn(jobDir(id));  // a scan of /proc: not in the tight loop below
+        std::this_thread::sleep_for(std::chrono::milliseconds(solver < 0 ? 20 : 0));
+        continue;
+      }
+      if (fs::exists(jobDir(id) / "checkpoint.h5")) {
+        if (::kill(solver, SIGSTOP) == 0 && solverIn(jobDir(id)) == solver) return solver;
+        ::kill(solver, SIGCONT);
+        return -1;  // it ended before it could be frozen
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return -1;
   }
@@ -215,7 +226,8 @@ TEST_F(SlurmExecutor, SprayJobRunsToTheEndWithTheLocalExecutorsResult) {
     EXPECT_EQ(done.at("attempt"), 1);
     EXPECT_EQ(done.at("progress").at("fraction"), 1.0);
     slurmResult = server->get("/v1/jobs/" + id + "/result").json();
-    EXPECT_NE(eventReasons(*server, id).find("submitting to Slurm as rcfd-" + id + "-1"), std::string::npos);
+    EXPECT_NE(eventReasons(*server, id).find("submitting to Slurm as rcfd-" + id + "-1"), std::string::npos)
+        << eventReasons(*server, id);
   }
   const std::string slurmJobId = storedSlurmJobId(dataDir(), id);
   ASSERT_FALSE(slurmJobId.empty());
@@ -265,7 +277,7 @@ TEST_F(SlurmExecutor, CancelCheckpointsAndEndsCancelled) {
 // while the job itself stays short enough for the second attempt to finish within the same limit.
 TEST_F(SlurmExecutor, JobPastItsTimeLimitIsRequeuedAndFinishesFromItsCheckpoint) {
   auto server = startSlurmServer({"--slurm-time", "spray=1", "--slurm-signal-lead", "0", "--slurm-requeues", "1"});
-  const std::string id = submit(*server, sprayJob(upload(*server), 3.0, 3));
+  const std::string id = submit(*server, sprayJob(upload(*server), 12.0, 3));
   const pid_t solver = frozenSolverWithCheckpoint(id);
   ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, id);
   const std::string firstSlurmJob = storedSlurmJobId(dataDir(), id);
@@ -289,7 +301,7 @@ TEST_F(SlurmExecutor, JobPastItsTimeLimitIsRequeuedAndFinishesFromItsCheckpoint)
 // once the node is back (state=resume) the job resumes from its checkpoint and finishes.
 TEST_F(SlurmExecutor, NodeDownMidJobRequeuesAndTheJobFinishesWhenTheNodeIsBack) {
   auto server = startSlurmServer();
-  const std::string id = submit(*server, sprayJob(upload(*server), 3.0, 4));
+  const std::string id = submit(*server, sprayJob(upload(*server), 12.0, 4));
   const pid_t solver = frozenSolverWithCheckpoint(id);
   ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, id);
   const std::string firstSlurmJob = storedSlurmJobId(dataDir(), id);
@@ -317,7 +329,7 @@ TEST_F(SlurmExecutor, ServerKilledMidJobFollowsTheSameSlurmJobToTheEnd) {
   std::string id, slurmJobId;
   {
     auto server = startSlurmServer();
-    id = submit(*server, sprayJob(upload(*server), 3.0, 5));
+    id = submit(*server, sprayJob(upload(*server), 12.0, 5));
     const pid_t solver = frozenSolverWithCheckpoint(id);
     ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, id);
     slurmJobId = storedSlurmJobId(dataDir(), id);
