@@ -397,9 +397,10 @@ void SlurmExecutor::sendCancels() {
     if (requests.count(id) && !f.cancelSent) {
       // SIGTERM to the batch shell, which passes it to the solver: it checkpoints and exits 130. A job
       // still pending in Slurm has nothing to checkpoint and is simply cancelled.
-      const auto r = f.slurmState == "PENDING"
-                         ? runCommand({"scancel", f.slurmJobId})
-                         : runCommand({"scancel", "--batch", "--signal=TERM", f.slurmJobId});
+      auto r = f.slurmState == "PENDING" ? runCommand({"scancel", f.slurmJobId})
+                                         : runCommand({"scancel", "--batch", "--signal=TERM", f.slurmJobId});
+      // Refused (the job is not running: pending since the last poll): cancelled outright.
+      if (r.exitCode != 0 && f.slurmState != "PENDING") r = runCommand({"scancel", f.slurmJobId});
       if (r.exitCode != 0)
         std::cerr << "rcfd-server: scancel of Slurm job " << f.slurmJobId << " (job " << id
                   << "): " << commandMessage(r) << "\n";

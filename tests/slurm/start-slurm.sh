@@ -110,8 +110,8 @@ export SLURM_CONF=$conf
 munged --socket="$dir/munge/munge.socket" --key-file="$dir/munge-key/munge.key" \
   --pid-file="$dir/munged.pid" --log-file="$dir/log/munged.log" --seed-file="$dir/munge-key/seed" \
   || unavailable "munged did not start (see $dir/log/munged.log)"
-slurmctld -c -f "$conf" || unavailable "slurmctld did not start (see $dir/log/slurmctld.log)"
-slurmd -c -f "$conf" || unavailable "slurmd did not start (see $dir/log/slurmd.log)"
+slurmctld -c -f "$conf" 2>> "$dir/log/slurmctld.stderr" || unavailable "slurmctld did not start (see $dir/log/slurmctld.log)"
+slurmd -c -f "$conf" 2>> "$dir/log/slurmd.stderr" || unavailable "slurmd did not start (see $dir/log/slurmd.log)"
 
 for _ in $(seq 300); do
   state=$(sinfo -h -n "$node" -o %T 2>/dev/null || true)
