@@ -283,6 +283,7 @@ void SlurmExecutor::terminate(const std::string& id) {
 }
 
 void SlurmExecutor::shutdown() {
+  std::lock_guard once(shutdownMutex_);
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;

@@ -79,6 +79,7 @@ class SlurmExecutor final : public JobExecutor {
   const ServerConfig& config_;
   std::string user_;  ///< whose Slurm jobs squeue lists: the server's own
   std::mutex mutex_;
+  std::mutex shutdownMutex_;  // serialises shutdown() calls (the signal handler's, main's, the destructor's)
   std::condition_variable wake_;
   bool stopping_ = false;
   bool pending_ = false;

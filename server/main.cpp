@@ -262,7 +262,9 @@ int main(int argc, char** argv) {
     signals.async_wait([&](const boost::system::error_code& ec, int sig) {
       if (ec) return;
       std::cerr << "rcfd-server: signal " << sig
-                << ": stopping; running solvers checkpoint and resume on the next start\n";
+                << (config.executor == "slurm"
+                        ? ": stopping; jobs in Slurm go on, and the next start follows them\n"
+                        : ": stopping; running solvers checkpoint and resume on the next start\n");
       listener->stop([&] {
         net::post(blocking, [&] {  // waits up to the grace period: never on an io thread
           pool.shutdown();
