@@ -99,7 +99,7 @@ MinJobAge=600
 # Seconds between SIGTERM and SIGKILL when a job ends by its time limit or a cancel: time to checkpoint.
 KillWait=10
 SchedulerType=sched/builtin
-# A node an administrator set DOWN stays down until `scontrol update nodename=... state=resume`.
+# A node an administrator set DOWN stays down until it is resumed (scontrol update ... state=resume).
 ReturnToService=1
 SlurmdParameters=config_overrides
 NodeName=$node NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=4000 State=UNKNOWN
