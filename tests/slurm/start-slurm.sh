@@ -37,7 +37,8 @@ unavailable() {
 # A free TCP port on loopback at or above $1.
 free_port() {
   local port=$1
-  while ss -Htln "sport = :$port" | grep -q .; do port=$((port + 1)); done
+  # A connection that succeeds finds a listener there (bash's /dev/tcp: no tool needed).
+  while (exec 3<> "/dev/tcp/127.0.0.1/$port") 2> /dev/null; do port=$((port + 1)); done
   echo "$port"
 }
 
