@@ -297,6 +297,29 @@ TEST_F(SlurmExecutor, JobPastItsTimeLimitIsRequeuedAndFinishesFromItsCheckpoint)
   EXPECT_EQ(slurmJobsNamed("rcfd-" + id).size(), 2u);
 }
 
+// Slurm's warning ahead of the time limit (--slurm-signal-lead): the batch shell passes SIGTERM on, the
+// solver checkpoints and exits 130 before the limit, and the job is submitted again and resumes. A job
+// far too long for its limit meets the warning in every attempt: past --slurm-requeues it FAILS, saying so.
+TEST_F(SlurmExecutor, TimeLimitWarningCheckpointsAndResumesUntilTheRequeuesAreUsedUp) {
+  auto server = startSlurmServer({"--slurm-time", "spray=1", "--slurm-signal-lead", "55", "--slurm-requeues", "1"});
+  const std::string id = submit(*server, sprayJob(upload(*server), 1000.0, 6));
+  const auto done = pollJob(*server, id, isFinal, std::chrono::seconds(150));
+  ASSERT_EQ(done.at("state"), "FAILED") << done.dump(2) << eventReasons(*server, id);
+  EXPECT_EQ(done.at("attempt"), 2);
+  const std::string events = eventReasons(*server, id);
+  EXPECT_NE(events.find("after the solver checkpointed on SIGTERM (the time limit's warning); submitted again to "
+                        "resume from its checkpoint (requeue 1 of 1)"),
+            std::string::npos)
+      << events;
+  EXPECT_NE(done.at("error").get<std::string>().find("not submitted again after 1 requeue(s)"), std::string::npos)
+      << done.dump(2);
+  const std::string secondSlurmJob = storedSlurmJobId(dataDir(), id);
+  EXPECT_EQ(readText(jobDir(id) / ("slurm-" + secondSlurmJob + ".exit")), "130\n");
+  EXPECT_TRUE(fs::exists(jobDir(id) / ("slurm-" + secondSlurmJob + ".term")));
+  EXPECT_NE(readText(jobDir(id) / "solver.log").find("resumed from"), std::string::npos)
+      << "the second attempt did not resume: " << readText(jobDir(id) / "solver.log");
+}
+
 // The node goes DOWN under a running job: Slurm ends it NODE_FAIL, the server submits it again, and
 // once the node is back (state=resume) the job resumes from its checkpoint and finishes.
 TEST_F(SlurmExecutor, NodeDownMidJobRequeuesAndTheJobFinishesWhenTheNodeIsBack) {
