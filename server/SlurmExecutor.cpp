@@ -228,35 +228,11 @@ void SlurmExecutor::follow(const std::string& id, Followed followed) {
   busy_ = static_cast<int>(followed_.size());
 }
 
-std::string SlurmExecutor::slurmJobNamed(const std::string& name) {
-  const auto r = runCommand({"squeue", "--noheader", "--states=all", "--user=" + user_, "--name=" + name,
-                             "--format=%i"});
-  if (r.exitCode != 0) return {};
-  std::istringstream lines(r.out);
-  std::string first;
-  std::getline(lines, first);
-  return trim(first);
-}
-
 void SlurmExecutor::start() {
   for (const auto& job : store_.unfinished()) {
-    std::string slurmJobId = job.slurmJobId;
-    // A server that stopped between sbatch and storing its answer: the job is in Slurm under its name.
-    if (slurmJobId.empty()) {
-      slurmJobId = slurmJobNamed(slurmJobName(job.id, job.attempt));
-      if (!slurmJobId.empty()) store_.setSlurmJobId(job.id, slurmJobId);
-    }
-    if (slurmJobId.empty()) {
-      if (job.state == state::running)
-        store_.transition(job.id, state::running, state::queued,
-                          "server restarted before the job reached Slurm; it is submitted again");
-      else
-        store_.transition(job.id, state::cancelling, state::cancelled,
-                          "server restarted while the job was cancelling, before it reached Slurm");
-      continue;
-    }
     Followed followed;
-    followed.slurmJobId = slurmJobId;
+    followed.slurmJobId = job.slurmJobId;
+    followed.slurmJobName = slurmJobName(job.id, job.attempt);
     follow(job.id, followed);
     if (job.state == state::cancelling) cancelRequests_.insert(job.id);
   }
@@ -354,6 +330,7 @@ void SlurmExecutor::submit(const JobRecord& job) {
   args.insert(args.end(), slurm.extraArguments.begin(), slurm.extraArguments.end());
 
   Followed followed;
+  followed.slurmJobName = name;
   std::string failure;
   try {
     writeJobFile(store_, config_, job);
@@ -395,6 +372,13 @@ void SlurmExecutor::sendCancels() {
   }
   const auto now = std::chrono::steady_clock::now();
   for (auto& [id, f] : followed_) {
+    if (f.slurmJobId.empty()) {  // not found in Slurm yet: the cancel waits for the next poll
+      if (requests.count(id)) {
+        std::lock_guard lock(mutex_);
+        cancelRequests_.insert(id);
+      }
+      continue;
+    }
     if (requests.count(id) && !f.cancelSent) {
       // SIGTERM to the batch shell, which passes it to the solver: it checkpoints and exits 130. A job
       // still pending in Slurm has nothing to checkpoint and is simply cancelled.
@@ -436,7 +420,7 @@ void SlurmExecutor::readProgress(const std::string& id, Followed& followed) {
 
 void SlurmExecutor::poll() {
   if (followed_.empty()) return;
-  const auto r = runCommand({"squeue", "--noheader", "--states=all", "--user=" + user_, "--format=%i|%T"});
+  const auto r = runCommand({"squeue", "--noheader", "--states=all", "--user=" + user_, "--format=%i|%T|%j"});
   if (r.exitCode != 0) {
     if (!squeueFailing_)
       std::cerr << "rcfd-server: squeue failed (jobs stay as they are until it answers): " << commandMessage(r) << "\n";
@@ -444,14 +428,30 @@ void SlurmExecutor::poll() {
     return;
   }
   squeueFailing_ = false;
-  std::map<std::string, std::string> states;
+  std::map<std::string, std::string> states, idsByName;
   std::istringstream lines(r.out);
   for (std::string line; std::getline(lines, line);) {
     const auto bar = line.find('|');
-    if (bar != std::string::npos) states[trim(line.substr(0, bar))] = trim(line.substr(bar + 1));
+    const auto bar2 = bar == std::string::npos ? bar : line.find('|', bar + 1);
+    if (bar2 == std::string::npos) continue;
+    const std::string slurmJobId = trim(line.substr(0, bar));
+    states[slurmJobId] = trim(line.substr(bar + 1, bar2 - bar - 1));
+    idsByName[trim(line.substr(bar2 + 1))] = slurmJobId;
   }
   std::vector<std::string> ended;
   for (auto& [id, f] : followed_) {
+    if (f.slurmJobId.empty()) {
+      if (const auto named = idsByName.find(f.slurmJobName); named != idsByName.end()) {
+        f.slurmJobId = named->second;
+        store_.setSlurmJobId(id, f.slurmJobId);
+      } else {
+        if (++f.pollsUnlisted >= kPollsBeforeForgotten) {
+          notInSlurm(id);
+          ended.push_back(id);
+        }
+        continue;
+      }
+    }
     readProgress(id, f);
     const auto it = states.find(f.slurmJobId);
     if (it != states.end()) {
@@ -472,6 +472,13 @@ void SlurmExecutor::poll() {
   for (const auto& id : ended) followed_.erase(id);
   busy_ = static_cast<int>(followed_.size());
   if (!ended.empty()) wake();  // slots are free: submit what is queued
+}
+
+void SlurmExecutor::notInSlurm(const std::string& id) {
+  if (!store_.transition(id, state::running, state::queued,
+                         "the server stopped before the job reached Slurm; it is submitted again"))
+    store_.transition(id, state::cancelling, state::cancelled,
+                      "the server stopped while the job was cancelling, before it reached Slurm");
 }
 
 void SlurmExecutor::finish(const std::string& id, Followed& f, const std::string& slurmState) {

@@ -38,8 +38,10 @@ class SlurmExecutor final : public JobExecutor {
   SlurmExecutor(const SlurmExecutor&) = delete;
   SlurmExecutor& operator=(const SlurmExecutor&) = delete;
 
-  /// Follows the Slurm jobs of the jobs a previous server left RUNNING or CANCELLING; a RUNNING job
-  /// that never reached Slurm is queued again. Then starts the thread that talks to Slurm.
+  /// Follows the Slurm jobs of the jobs a previous server left RUNNING or CANCELLING: by their stored
+  /// Slurm ids, or, where the server stopped before it stored one, by their Slurm job names (a job that
+  /// squeue does not list under its name never reached Slurm and is queued again). Then starts the
+  /// thread that talks to Slurm.
   void start() override;
   void wake() override;
   /// Queues the cancel for the Slurm thread (scancel is never run on an HTTP thread).
@@ -53,7 +55,8 @@ class SlurmExecutor final : public JobExecutor {
  private:
   /// A job in Slurm that this server follows.
   struct Followed {
-    std::string slurmJobId;
+    std::string slurmJobId;              ///< empty until squeue lists slurmJobName (a restart's lookup)
+    std::string slurmJobName;            ///< rcfd-<id>-<attempt>
     std::string slurmState;              ///< as squeue last reported it; empty before the first poll
     std::uintmax_t progressBytes = 0;    ///< size of progress.jsonl when last read
     std::uintmax_t logStart = 0;         ///< size of solver.log before this attempt
@@ -72,8 +75,8 @@ class SlurmExecutor final : public JobExecutor {
   /// Ends the job whose Slurm job ended in `slurmState` (empty: Slurm no longer lists it).
   void finish(const std::string& id, Followed& followed, const std::string& slurmState);
   void follow(const std::string& id, Followed followed);
-  /// The id of the server's Slurm job named `name`, empty if squeue lists none.
-  std::string slurmJobNamed(const std::string& name);
+  /// A job a previous server left RUNNING or CANCELLING that Slurm never got: QUEUED or CANCELLED.
+  void notInSlurm(const std::string& id);
 
   JobStore& store_;
   const ServerConfig& config_;

@@ -370,3 +370,32 @@ TEST_F(SlurmExecutor, ServerKilledMidJobFollowsTheSameSlurmJobToTheEnd) {
   EXPECT_NE(server->stderrText().find("following 1 job(s) already in Slurm"), std::string::npos)
       << server->stderrText();
 }
+
+// A server killed between sbatch and storing its answer left the job RUNNING without a Slurm id (made
+// here by clearing the stored id): the next server finds the Slurm job by its name (rcfd-ID-ATTEMPT),
+// stores its id and follows it; nothing is submitted again.
+TEST_F(SlurmExecutor, ServerKilledBeforeStoringTheSlurmIdFindsTheJobByItsName) {
+  std::string id, slurmJobId;
+  {
+    auto server = startSlurmServer();
+    id = submit(*server, sprayJob(upload(*server), 12.0, 7));
+    const pid_t solver = frozenSolverWithCheckpoint(id);
+    ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, id);
+    slurmJobId = storedSlurmJobId(dataDir(), id);
+    server->stop(SIGKILL);
+    ::kill(solver, SIGCONT);
+  }
+  ASSERT_FALSE(slurmJobId.empty());
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dataDir() / "rcfd.sqlite").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "UPDATE jobs SET slurm_job_id = NULL", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+  ASSERT_EQ(storedSlurmJobId(dataDir(), id), "");
+
+  auto server = startSlurmServer();
+  const auto done = pollJob(*server, id, isFinal);
+  EXPECT_EQ(done.at("state"), "SUCCEEDED") << done.dump(2) << eventReasons(*server, id);
+  EXPECT_EQ(done.at("attempt"), 1);
+  EXPECT_EQ(storedSlurmJobId(dataDir(), id), slurmJobId);
+  EXPECT_EQ(slurmJobsNamed("rcfd-" + id), std::vector<std::string>{slurmJobId + " COMPLETED"});
+}
