@@ -44,6 +44,7 @@ free_port() {
 
 if [ "$action" = stop ]; then
   stop_daemons
+  rm -f "$dir/ready"
   exit 0
 fi
 [ "$action" = start ] || { echo "start-slurm.sh: unknown action $action" >&2; exit 2; }
