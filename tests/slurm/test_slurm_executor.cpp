@@ -271,6 +271,25 @@ TEST_F(SlurmExecutor, CancelCheckpointsAndEndsCancelled) {
   EXPECT_EQ(solverIn(jobDir(id)), -1);
 }
 
+// A solver that fails on the node: Slurm ends the batch job FAILED, and the job FAILS naming the Slurm
+// state, the solver's exit and the end of its log. The failing solver is a script (--slurm-solver): the
+// real one fails only on inputs the server already refuses at submission.
+TEST_F(SlurmExecutor, ASolverThatFailsOnTheNodeEndsFailedWithSlurmsStateAndItsLog) {
+  const auto failing = tmp_->path() / "failing-solver.sh";
+  std::ofstream(failing) << "#!/bin/sh\necho 'error: the node has no scratch space' >&2\nexit 3\n";
+  fs::permissions(failing, fs::perms::owner_all);
+  auto server = startSlurmServer({"--slurm-solver", failing.string()});
+  const std::string id = submit(*server, sprayJob(upload(*server), 0.5, 8));
+  const auto done = pollJob(*server, id, isFinal, std::chrono::seconds(60));
+  ASSERT_EQ(done.at("state"), "FAILED") << done.dump(2) << eventReasons(*server, id);
+  const std::string error = done.at("error");
+  const std::string slurmJobId = storedSlurmJobId(dataDir(), id);
+  EXPECT_NE(error.find("Slurm job " + slurmJobId + " ended FAILED (the run failed (exit 3))"), std::string::npos)
+      << error;
+  EXPECT_NE(error.find("error: the node has no scratch space"), std::string::npos) << error;
+  EXPECT_EQ(done.at("attempt"), 1);  // a failure is not a reason to submit again
+}
+
 // A job past its Slurm time limit (one minute, the shortest Slurm has) ends TIMEOUT in Slurm and is
 // submitted again; the second attempt resumes from the checkpoint and finishes. The first attempt's
 // solver is frozen once it has checkpointed, so that it outlasts the limit however fast the machine is,
