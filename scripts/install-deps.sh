@@ -25,6 +25,8 @@ packages=(
   libspdlog-dev          # logging
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
+  slurm-wlm munge        # rcfd-server --executor slurm: sbatch/squeue/scancel, and the single-node test
+                         # cluster of tests/slurm (slurmctld, slurmd, munged)
 )
 if [ "$test_tools" = 1 ]; then
   # The XDMF sidecars of the HDF5 outputs must open in ParaView: scripts/check-paraview.py opens them

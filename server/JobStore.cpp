@@ -34,7 +34,7 @@ namespace {
 
 // Ordered migrations: entry i brings the schema from version i to i + 1. Never edit a released
 // entry; append a new one.
-const std::array<const char*, 4> kMigrations = {
+const std::array<const char*, 5> kMigrations = {
     R"sql(
 CREATE TABLE jobs (
   seq INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -101,6 +101,11 @@ ALTER TABLE databases ADD COLUMN owner TEXT NOT NULL DEFAULT 'admin';
     R"sql(
 ALTER TABLE jobs ADD COLUMN phase TEXT;
 ALTER TABLE jobs ADD COLUMN phase_fraction REAL;
+)sql",
+    // The Slurm job running a job's current attempt (rcfd-server --executor slurm): a restarted server
+    // follows it instead of submitting the job again.
+    R"sql(
+ALTER TABLE jobs ADD COLUMN slurm_job_id TEXT;
 )sql"};
 
 /// The stored form of an Idempotency-Key: OWNER/KEY. Keys are names clients choose ("quick-db-1"), so
@@ -219,7 +224,7 @@ class Transaction {
 constexpr const char* kJobColumns =
     "seq, id, kind, state, request, idempotency_key, body_hash, database_ref, progress, sim_time, "
     "wall_time, eta_s, created_at, started_at, finished_at, updated_at, error, attempt, owner, phase, "
-    "phase_fraction";
+    "phase_fraction, slurm_job_id";
 
 void insertEvent(sqlite3* db, const std::string& id, const std::string& from, const std::string& to,
                  const std::string& reason, const std::string& at) {
@@ -329,6 +334,7 @@ JobRecord JobStore::readJob(void* statement) {
   j.owner = s.text(18);
   j.phase = s.text(19);
   j.phaseFraction = s.optDouble(20);
+  j.slurmJobId = s.text(21);
   return j;
 }
 
@@ -418,19 +424,26 @@ std::vector<JobRecord> JobStore::queued(int limit) {
   return listJobs(f);
 }
 
-bool JobStore::markStarted(const std::string& id) {
+bool JobStore::markStarted(const std::string& id, const std::string& reason) {
   std::lock_guard lock(mutex_);
   Transaction tx(db_);
   const std::string now = nowRfc3339();
   Statement s(db_,
               "UPDATE jobs SET state = 'RUNNING', attempt = attempt + 1, started_at = ?2, "
-              "updated_at = ?2, error = NULL WHERE id = ?1 AND state = 'QUEUED'");
+              "updated_at = ?2, error = NULL, slurm_job_id = NULL WHERE id = ?1 AND state = 'QUEUED'");
   s.bind(1, id).bind(2, now).run();
   if (sqlite3_changes(db_) == 0) return false;
-  insertEvent(db_, id, state::queued, state::running, "worker started", now);
+  insertEvent(db_, id, state::queued, state::running, reason, now);
   tx.commit();
   changed(id);
   return true;
+}
+
+void JobStore::setSlurmJobId(const std::string& id, const std::string& slurmJobId) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "UPDATE jobs SET slurm_job_id = ?2, updated_at = ?3 WHERE id = ?1");
+  s.bind(1, id).bindOrNull(2, slurmJobId).bind(3, nowRfc3339()).run();
+  changed(id);
 }
 
 void JobStore::updateProgress(const std::string& id, double fraction, std::optional<double> simTime,

@@ -51,6 +51,7 @@ struct JobRecord {
   std::string owner;             ///< the user who submitted it (Users.hpp)
   std::string phase;             ///< the phase a running job is in ("fill", "run", ...); empty if none
   std::optional<double> phaseFraction;  ///< how far that phase is [-]
+  std::string slurmJobId;        ///< the Slurm job of the current attempt (--executor slurm); empty if none
 };
 
 /// One bin of a job's coverage histogram.
@@ -109,8 +110,11 @@ class JobStore {
                   const std::string& reason = {}, const std::string& error = {});
   /// The oldest QUEUED jobs, in submission order.
   std::vector<JobRecord> queued(int limit);
-  /// QUEUED -> RUNNING with attempt + 1 and started_at; false if it was no longer QUEUED.
-  bool markStarted(const std::string& id);
+  /// QUEUED -> RUNNING with attempt + 1 and started_at, the event saying `reason`, and no Slurm job
+  /// yet (the previous attempt's is forgotten); false if it was no longer QUEUED.
+  bool markStarted(const std::string& id, const std::string& reason = "worker started");
+  /// Records the Slurm job that runs the job's current attempt (SlurmExecutor).
+  void setSlurmJobId(const std::string& id, const std::string& slurmJobId);
   /// The solver's last progress line (docs/contracts.md, "Progress"); `phase` empty: none named.
   void updateProgress(const std::string& id, double fraction, std::optional<double> simTime,
                       std::optional<double> wallTime, std::optional<double> eta, const std::string& phase = {},

@@ -16,7 +16,7 @@
 #include "Ids.hpp"
 #include "PageToken.hpp"
 #include "Problem.hpp"
-#include "WorkerPool.hpp"
+#include "JobExecutor.hpp"
 #include "scene/SceneJson.hpp"
 #include "scene/SceneLoader.hpp"
 #include "scene/SchemaValidator.hpp"
@@ -127,7 +127,7 @@ std::string contentTypeFor(const std::string& name) {
 
 }  // namespace
 
-JobsApi::JobsApi(JobStore& store, WorkerPool& pool, const ServerConfig& config)
+JobsApi::JobsApi(JobStore& store, JobExecutor& pool, const ServerConfig& config)
     : store_(store), pool_(pool), config_(config) {
   store_.setChangeListener([this](const std::string& id) { views_.invalidate(id); });
 }

@@ -3,7 +3,7 @@
 /// Handlers of /v1/jobs: submit (validated with rcfd::loadJob, Idempotency-Key), list (filters,
 /// opaque page tokens), get (answered from JobViewCache while the row is unchanged), cancel, result,
 /// coverage and artifacts. Each handler only reads or writes rows and files; solvers run in the
-/// WorkerPool. Every handler acts for a Caller: a job is owned by its submitter, and a plain user's
+/// JobExecutor. Every handler acts for a Caller: a job is owned by its submitter, and a plain user's
 /// request about another user's job is answered exactly as one about an id that does not exist (404),
 /// so ids of other users' jobs are neither usable nor confirmed; admins act on every job.
 
@@ -16,12 +16,12 @@
 
 namespace rcfd::server {
 
-class WorkerPool;
+class JobExecutor;
 
 class JobsApi {
  public:
   /// Registers the view cache as the store's change listener (until destruction).
-  JobsApi(JobStore& store, WorkerPool& pool, const ServerConfig& config);
+  JobsApi(JobStore& store, JobExecutor& pool, const ServerConfig& config);
   ~JobsApi();
   JobsApi(const JobsApi&) = delete;
   JobsApi& operator=(const JobsApi&) = delete;
@@ -51,7 +51,7 @@ class JobsApi {
   Response servedJobFile(int fd, const JobRecord& job, const Target& target) const;
 
   JobStore& store_;
-  WorkerPool& pool_;
+  JobExecutor& pool_;
   const ServerConfig& config_;
   JobViewCache views_;  // bodies of GET /v1/jobs/{id}
 };

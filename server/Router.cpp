@@ -4,8 +4,8 @@
 #include "Ids.hpp"
 #include "OpenApi.hpp"
 #include "Problem.hpp"
+#include "JobExecutor.hpp"
 #include "WebPage.hpp"
-#include "WorkerPool.hpp"
 #include "scene/SceneLoader.hpp"
 
 namespace rcfd::server {
@@ -27,7 +27,7 @@ StringResponse noRoute(const Target& target) {
 }
 }  // namespace
 
-Router::Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const ServerConfig& config)
+Router::Router(JobStore& store, JobExecutor& pool, Metrics& metrics, const ServerConfig& config)
     : store_(store),
       pool_(pool),
       metrics_(metrics),

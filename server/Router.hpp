@@ -16,7 +16,7 @@ namespace rcfd::server {
 
 class Router {
  public:
-  Router(JobStore& store, WorkerPool& pool, Metrics& metrics, const ServerConfig& config);
+  Router(JobStore& store, JobExecutor& pool, Metrics& metrics, const ServerConfig& config);
 
   /// Answers a complete request (JSON body already read and within its size limit) for `caller`, as
   /// authenticate() found it from the request's header (nullopt: no known token; 401 unless public).
@@ -38,7 +38,7 @@ class Router {
   Response route(const Request& req, const Target& target, const std::optional<Caller>& caller);
 
   JobStore& store_;
-  WorkerPool& pool_;
+  JobExecutor& pool_;
   Metrics& metrics_;
   const ServerConfig& config_;
   JobsApi jobs_;

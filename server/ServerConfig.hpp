@@ -5,11 +5,27 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "Users.hpp"
 
 namespace rcfd::server {
+
+/// How `--executor slurm` submits jobs (docs/cluster.md): the sbatch options a site chooses.
+struct SlurmSettings {
+  std::string partition;                       ///< --partition; empty: the cluster's default
+  std::string account;                         ///< --account; empty: the user's default
+  std::map<std::string, std::string> timeLimits;  ///< job kind -> --time (Slurm's formats); absent: the partition's
+  int cpusPerJob = 1;                          ///< --cpus-per-task, and the solver's OMP_NUM_THREADS
+  std::vector<std::string> extraArguments;     ///< further sbatch arguments, as given (--qos=..., --mem=...)
+  std::filesystem::path solverPath;            ///< rcfd-solve as the compute nodes see it
+  std::chrono::seconds pollInterval{5};        ///< between two squeue calls for all jobs
+  int requeues = 2;                            ///< times a job Slurm ended by TIMEOUT, NODE_FAIL or PREEMPTED is submitted again
+  std::chrono::seconds signalLead{60};         ///< SIGTERM this long before the time limit, to checkpoint
+  int maxJobs = 1000;                          ///< jobs in Slurm at once; more stay QUEUED in the server
+};
 
 struct ServerConfig {
   std::filesystem::path dataDir;      ///< rcfd.sqlite, jobs/<id>/, databases/
@@ -31,6 +47,8 @@ struct ServerConfig {
   std::chrono::seconds shutdownGrace{120};           ///< wait for solvers to checkpoint on stop
   std::chrono::seconds cancelGrace{30};              ///< a cancelled solver still running after this is killed
   int autoRetries = 1;  ///< times a job whose solver was killed from outside (SIGKILL: out of memory) is requeued
+  std::string executor = "local";  ///< where jobs run: "local" (child processes) or "slurm" (JobExecutor.hpp)
+  SlurmSettings slurm;             ///< with executor "slurm"
 
   std::filesystem::path jobDir(const std::string& id) const { return dataDir / "jobs" / id; }
   std::filesystem::path databaseDir() const { return dataDir / "databases"; }

@@ -18,7 +18,7 @@
 #include <sstream>
 
 #include "ChildSignals.hpp"
-#include "DatabaseRef.hpp"
+#include "SolverRun.hpp"
 #include "core/Errors.hpp"
 
 namespace rcfd::server {
@@ -26,74 +26,6 @@ namespace rcfd::server {
 namespace {
 
 constexpr auto kProgressWriteInterval = std::chrono::milliseconds(250);  // throttle row updates
-constexpr std::size_t kReasonLines = 6;       // stderr lines quoted in a failure reason
-constexpr std::size_t kReasonMaxChars = 2000;
-
-std::optional<double> optionalNumber(const nlohmann::json& j, const char* key) {
-  auto it = j.find(key);
-  if (it == j.end() || !it->is_number()) return std::nullopt;
-  return it->get<double>();
-}
-
-/// The phase a progress line names: a short word ("fill", "run"), empty when absent or not one.
-std::string phaseOf(const nlohmann::json& j) {
-  constexpr std::size_t kPhaseMaxChars = 32;
-  auto it = j.find("phase");
-  if (it == j.end() || !it->is_string()) return {};
-  const std::string& phase = it->get_ref<const std::string&>();
-  return phase.size() <= kPhaseMaxChars ? phase : std::string();
-}
-
-/// Stores the progress line `p` as the job's progress.
-void storeProgress(JobStore& store, const std::string& id, const nlohmann::json& p) {
-  const auto number = [&](const char* key) { return optionalNumber(p, key); };
-  store.updateProgress(id, number("fraction").value_or(0.0), number("sim_time"), number("wall_time"),
-                       number("eta_s"), phaseOf(p), number("phase_fraction"));
-}
-
-/// The last non-empty lines the solver wrote to stderr during this attempt.
-std::string logTail(const std::filesystem::path& log, std::streamoff from) {
-  std::ifstream in(log, std::ios::binary);
-  if (!in) return {};
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  // Read at most the last 64 KiB of this attempt's output.
-  const std::streamoff start = std::max(from, size - std::streamoff(64 * 1024));
-  in.seekg(start);
-  std::vector<std::string> lines;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") != std::string::npos) lines.push_back(line);
-  }
-  std::string out;
-  const std::size_t first = lines.size() > kReasonLines ? lines.size() - kReasonLines : 0;
-  for (std::size_t i = first; i < lines.size(); ++i) out += (out.empty() ? "" : "\n") + lines[i];
-  if (out.size() > kReasonMaxChars) out = "..." + out.substr(out.size() - kReasonMaxChars);
-  return out;
-}
-
-std::string signalName(int sig) {
-  const char* abbrev = sigabbrev_np(sig);
-  std::string name = abbrev ? std::string("SIG") + abbrev : "signal " + std::to_string(sig);
-  return name + " (" + std::to_string(sig) + ")";
-}
-
-/// Coverage histogram bins from summary.json (coverage.histogram.{edges,counts}; docs/contracts.md,
-/// "summary.json").
-std::vector<CoverageBin> coverageBins(const nlohmann::json& summary) {
-  std::vector<CoverageBin> bins;
-  const auto cov = summary.find("coverage");
-  if (cov == summary.end() || !cov->is_object()) return bins;
-  const auto hist = cov->find("histogram");
-  if (hist == cov->end() || !hist->is_object()) return bins;
-  const auto& edges = hist->value("edges", nlohmann::json::array());
-  const auto& counts = hist->value("counts", nlohmann::json::array());
-  if (!edges.is_array() || !counts.is_array() || edges.size() != counts.size() + 1) return bins;
-  for (std::size_t i = 0; i < counts.size(); ++i)
-    bins.push_back({edges[i].get<double>(), edges[i + 1].get<double>(), counts[i].get<double>()});
-  return bins;
-}
 
 }  // namespace
 
@@ -135,21 +67,6 @@ void WorkerPool::terminate(const std::string& id) {
   cancelSent_.emplace(id, std::chrono::steady_clock::now());
 }
 
-bool WorkerPool::isRunnable(JobRecord& job) {
-  if (job.databaseRef.empty()) return true;
-  const DatabaseRef ref = resolveDatabaseRef(store_, config_, job.databaseRef);
-  switch (ref.status) {
-    case DatabaseRef::Status::ready:
-      return true;
-    case DatabaseRef::Status::pending:
-      return false;
-    default:
-      store_.transition(job.id, state::queued, state::failed, {},
-                        "its database cannot be used: " + ref.detail);
-      return false;
-  }
-}
-
 void WorkerPool::schedulerLoop() {
   for (;;) {
     std::vector<std::thread> toJoin;
@@ -171,7 +88,7 @@ void WorkerPool::schedulerLoop() {
     if (freeSlots <= 0) continue;
     for (auto& job : store_.queued(256)) {
       if (freeSlots <= 0) break;
-      if (!isRunnable(job)) continue;
+      if (!databaseReady(store_, config_, job)) continue;
       if (!store_.markStarted(job.id)) continue;  // cancelled meanwhile
       std::lock_guard lock(mutex_);
       if (stopping_) {
@@ -194,18 +111,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
   bool killedAfterCancel = false;
   std::string setupError;
   try {
-    fs::create_directories(dir);
-    auto document = nlohmann::json::parse(job.request);
-    if (!job.databaseRef.empty()) {
-      const DatabaseRef ref = resolveDatabaseRef(store_, config_, job.databaseRef);
-      document["database"] = fs::absolute(ref.path).string();
-    }
-    {
-      std::ofstream out(dir / "job.json.tmp");
-      out << document.dump(2) << "\n";
-      if (!out) throw std::runtime_error("cannot write " + (dir / "job.json").string());
-    }
-    fs::rename(dir / "job.json.tmp", dir / "job.json");
+    writeJobFile(store_, config_, job);
     if (fs::exists(log)) logStart = static_cast<std::streamoff>(fs::file_size(log));
   } catch (const std::exception& e) {
     setupError = std::string("could not prepare the job directory: ") + e.what();
@@ -351,15 +257,7 @@ void WorkerPool::finishJob(const JobRecord& job, int waitStatus, const std::stri
   if (WIFEXITED(waitStatus)) {
     const int code = WEXITSTATUS(waitStatus);
     if (code == exit_code::success) {
-      const auto path = config_.jobDir(job.id) / "summary.json";
-      std::ifstream in(path);
-      auto summary = nlohmann::json::parse(in, nullptr, false);
-      if (!in || summary.is_discarded() || !summary.is_object()) {
-        store_.transition(job.id, from, state::failed, {},
-                          "the solver exited 0 but summary.json is missing or not a JSON object");
-        return;
-      }
-      store_.markSucceeded(job.id, summary, coverageBins(summary));
+      storeSucceeded(store_, config_, job.id, from);
       return;
     }
     if (code == exit_code::cancelled) {

@@ -16,37 +16,37 @@
 #include <thread>
 #include <vector>
 
+#include "JobExecutor.hpp"
 #include "JobStore.hpp"
 #include "ServerConfig.hpp"
 
 namespace rcfd::server {
 
-class WorkerPool {
+class WorkerPool final : public JobExecutor {
  public:
   WorkerPool(JobStore& store, const ServerConfig& config);
-  ~WorkerPool();
+  ~WorkerPool() override;
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
   /// Re-queues jobs a previous server left RUNNING (CANCELLING ones become CANCELLED) and starts
   /// the scheduler.
-  void start();
+  void start() override;
   /// Something changed (a job was queued or finished): look for work now.
-  void wake();
+  void wake() override;
   /// Sends SIGTERM to the job's solver if one is running; the job is already CANCELLING.
-  void terminate(const std::string& id);
+  void terminate(const std::string& id) override;
   /// Stops starting jobs, sends SIGTERM to every solver, waits for them (up to the grace period,
   /// then SIGKILL); jobs interrupted this way go back to QUEUED and resume on the next start.
-  void shutdown();
+  void shutdown() override;
 
-  int busy();
-  int slots() const { return config_.workers; }
+  int busy() override;
+  int slots() const override { return config_.workers; }
 
  private:
   void schedulerLoop();
   void runJob(JobRecord job, std::uint64_t run);
   void finishJob(const JobRecord& job, int waitStatus, const std::string& reasonTail, bool killedAfterCancel);
-  bool isRunnable(JobRecord& job);
 
   JobStore& store_;
   const ServerConfig& config_;

@@ -26,6 +26,7 @@
 #include "PageToken.hpp"
 #include "Router.hpp"
 #include "ServerConfig.hpp"
+#include "SlurmExecutor.hpp"
 #include "TlsContext.hpp"
 #include "Users.hpp"
 #include "WorkerPool.hpp"
@@ -165,6 +166,34 @@ int main(int argc, char** argv) {
   app.add_option("--upload-check-timeout", uploadCheckTimeout,
                  "seconds the validation of an uploaded database may take before it is stopped (422)")
       ->capture_default_str()->check(CLI::Range(1, 86400));
+  app.add_option("--executor", config.executor,
+                 "where jobs run: local (solver processes on this machine) or slurm (batch jobs on a Slurm "
+                 "cluster that shares the data directory; docs/cluster.md)")
+      ->capture_default_str()->check(CLI::IsMember({"local", "slurm"}));
+  std::vector<std::string> slurmTimes;
+  std::string slurmSolver;
+  int slurmPoll = static_cast<int>(config.slurm.pollInterval.count());
+  int slurmLead = static_cast<int>(config.slurm.signalLead.count());
+  app.add_option("--slurm-partition", config.slurm.partition, "sbatch --partition (default: the cluster's)");
+  app.add_option("--slurm-account", config.slurm.account, "sbatch --account (default: the user's)");
+  app.add_option("--slurm-time", slurmTimes,
+                 "KIND=LIMIT: sbatch --time for jobs of that kind (database, calibration, spray), in Slurm's "
+                 "formats (minutes, H:MM:SS, D-HH); repeat per kind; default: the partition's limit");
+  app.add_option("--slurm-cpus", config.slurm.cpusPerJob, "CPUs per job (sbatch --cpus-per-task; the solver's threads)")
+      ->capture_default_str()->check(CLI::Range(1, 4096));
+  app.add_option("--slurm-sbatch-arg", config.slurm.extraArguments,
+                 "one more sbatch argument, as --slurm-sbatch-arg=--qos=long; repeatable")->allow_extra_args(false);
+  app.add_option("--slurm-solver", slurmSolver, "rcfd-solve as the compute nodes see it (default: --solver)");
+  app.add_option("--slurm-poll-interval", slurmPoll, "seconds between two squeue calls (one for all jobs)")
+      ->capture_default_str()->check(CLI::Range(1, 3600));
+  app.add_option("--slurm-requeues", config.slurm.requeues,
+                 "times a job Slurm ends by TIMEOUT, NODE_FAIL or PREEMPTED is submitted again to resume from its checkpoint")
+      ->capture_default_str()->check(CLI::Range(0, 100));
+  app.add_option("--slurm-signal-lead", slurmLead,
+                 "seconds before the time limit at which Slurm sends SIGTERM, so that the solver checkpoints (0: none)")
+      ->capture_default_str()->check(CLI::Range(0, 65535));
+  app.add_option("--slurm-max-jobs", config.slurm.maxJobs, "jobs in Slurm at once; more wait QUEUED in the server")
+      ->capture_default_str()->check(CLI::Range(1, 1000000));
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -198,16 +227,28 @@ int main(int argc, char** argv) {
     config.idleBeforeToken = std::chrono::seconds(idleBeforeToken);
     config.cancelGrace = std::chrono::seconds(cancelGrace);
     config.uploadCheckTimeout = std::chrono::seconds(uploadCheckTimeout);
+    config.slurm.pollInterval = std::chrono::seconds(slurmPoll);
+    config.slurm.signalLead = std::chrono::seconds(slurmLead);
+    config.slurm.solverPath = slurmSolver.empty() ? config.solverPath : std::filesystem::path(slurmSolver);
+    for (const auto& entry : slurmTimes) {
+      const auto eq = entry.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == entry.size())
+        throw std::runtime_error("--slurm-time must be KIND=LIMIT, got " + entry);
+      config.slurm.timeLimits[entry.substr(0, eq)] = entry.substr(eq + 1);
+    }
     // Connections beyond the descriptor limit would make accept fail: keep 64 for SQLite, logs, solvers.
     if (rlimit files{}; maxConnections->count() == 0 && ::getrlimit(RLIMIT_NOFILE, &files) == 0 &&
                         files.rlim_cur != RLIM_INFINITY)
       config.maxConnections = std::max(1, std::min(config.maxConnections, int(files.rlim_cur) - 64));
-    if (config.workers > 0 && ::access(config.solverPath.c_str(), X_OK) != 0)
+    if (config.executor == "local" && config.workers > 0 && ::access(config.solverPath.c_str(), X_OK) != 0)
       std::cerr << "rcfd-server: warning: solver " << config.solverPath.string()
                 << " is not executable; jobs will fail (use --solver)\n";
 
     JobStore store((config.dataDir / "rcfd.sqlite").string());
-    WorkerPool pool(store, config);
+    std::unique_ptr<JobExecutor> executor;
+    if (config.executor == "slurm") executor = std::make_unique<SlurmExecutor>(store, config);
+    else executor = std::make_unique<WorkerPool>(store, config);
+    JobExecutor& pool = *executor;
     Metrics metrics;
     Router router(store, pool, metrics, config);
     net::io_context ioc(ioThreads);
@@ -221,7 +262,9 @@ int main(int argc, char** argv) {
     signals.async_wait([&](const boost::system::error_code& ec, int sig) {
       if (ec) return;
       std::cerr << "rcfd-server: signal " << sig
-                << ": stopping; running solvers checkpoint and resume on the next start\n";
+                << (config.executor == "slurm"
+                        ? ": stopping; jobs in Slurm go on, and the next start follows them\n"
+                        : ": stopping; running solvers checkpoint and resume on the next start\n");
       listener->stop([&] {
         net::post(blocking, [&] {  // waits up to the grace period: never on an io thread
           pool.shutdown();
@@ -233,8 +276,12 @@ int main(int argc, char** argv) {
     const std::string host = bound.address().is_v6() ? "[" + bound.address().to_string() + "]"
                                                      : bound.address().to_string();
     std::cout << "listening on " << (tls ? "https" : "http") << "://" << host << ":" << bound.port() << std::endl;
-    std::cerr << "rcfd-server: data " << config.dataDir.string() << ", " << config.workers
-              << " worker slot(s), solver " << config.solverPath.string() << "\n";
+    if (config.executor == "slurm")
+      std::cerr << "rcfd-server: data " << config.dataDir.string() << ", jobs run in Slurm (at most "
+                << config.slurm.maxJobs << " at once), solver on the nodes " << config.slurm.solverPath.string() << "\n";
+    else
+      std::cerr << "rcfd-server: data " << config.dataDir.string() << ", " << config.workers
+                << " worker slot(s), solver " << config.solverPath.string() << "\n";
     pool.start();
     listener->run();
     // The io threads run until the shutdown handler stops them, even when no connection is open.

@@ -392,7 +392,7 @@ CREATE TABLE databases (id TEXT PRIMARY KEY, path TEXT NOT NULL, bytes INTEGER N
   {
     ServerProcess server(data, "single-token");
     const auto health = server.get("/v1/health").json();
-    EXPECT_EQ(health.at("schema_version"), 4);  // users (3), then the running job's phase (4)
+    EXPECT_EQ(health.at("schema_version"), 5);  // users (3), the running job's phase (4), the Slurm job id (5)
     EXPECT_EQ(health.at("version"), RCFD_VERSION);  // the project's, from CMakeLists.txt
     const auto job = server.get("/v1/jobs/" + oldJob);
     ASSERT_EQ(job.status, 200) << job.body;
@@ -406,7 +406,7 @@ CREATE TABLE databases (id TEXT PRIMARY KEY, path TEXT NOT NULL, bytes INTEGER N
     EXPECT_NE(reused.body.find(oldJob), std::string::npos) << reused.body;
     EXPECT_EQ(server.post("/v1/jobs", databaseJob(6).dump()).json().at("owner"), "admin");
   }
-  EXPECT_EQ(sqliteInt(store, "SELECT version FROM schema_version"), 4);
+  EXPECT_EQ(sqliteInt(store, "SELECT version FROM schema_version"), 5);
   EXPECT_EQ(sqliteInt(store, "SELECT COUNT(*) FROM jobs WHERE owner = 'admin'"), 2);
   EXPECT_EQ(sqliteInt(store, "SELECT COUNT(*) FROM databases WHERE owner = 'admin'"), 1);
 
