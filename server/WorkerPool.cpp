@@ -200,6 +200,8 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       const DatabaseRef ref = resolveDatabaseRef(store_, config_, job.databaseRef);
       document["database"] = fs::absolute(ref.path).string();
     }
+    if (job.kind == "import" && document.contains("case_dir"))  // checked at submit: inside the import root
+      document["case_dir"] = importCaseDirectory(config_.importRoot, document["case_dir"].get<std::string>()).string();
     {
       std::ofstream out(dir / "job.json.tmp");
       out << document.dump(2) << "\n";
