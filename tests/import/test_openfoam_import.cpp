@@ -23,6 +23,7 @@
 #include "import/FoamFile.hpp"
 #include "import/OpenFoamImport.hpp"
 #include "import/OpenFoamMesh.hpp"
+#include "jobs/JobRunner.hpp"
 #include "scene/SceneLoader.hpp"
 
 namespace fs = std::filesystem;
@@ -393,6 +394,43 @@ TEST_F(OpenFoamImport, ParserReadsUniformListsCommentsAndLabel64) {
   // Subnormal values, as OpenFOAM writes them, are numbers.
   auto h = rcfd::openfoam::FoamFile::fromText("FoamFile { format ascii; }\n2(9.0320351e-42 1)", "U");
   EXPECT_EQ(h.scalarList("U").size(), 2u);
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(OpenFoamImport, ImportJobWritesDatabaseResultAndSummary) {
+  const fs::path root = writeReconstructed();
+  rcfd::JobSpec job;
+  job.kind = "import";
+  job.scene = scene_;
+  job.source = {{"kind", "import"}, {"scene", sceneDocument()}, {"case_dir", root.string()}, {"times", "0.1:0.4"}};
+  rcfd::RunOptions options;
+  options.outDir = (dir_ / "job").string();
+  const json summary = rcfd::runJob(job, options);
+  EXPECT_EQ(summary.at("kind"), "import");
+  EXPECT_EQ(summary.at("frames"), 4);
+  EXPECT_EQ(json::parse(std::ifstream(dir_ / "job/summary.json")).at("database"), "database.h5");
+  auto db = rcfd::FieldDatabase::open((dir_ / "job/database.h5").string());
+  EXPECT_EQ(db->frameCount(), 4);
+  rcfd::h5::File result((dir_ / "job/result.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+  EXPECT_EQ(result.readDoubles("/fields/alpha_p_mean").size(), 16u);
+}
+
+TEST_F(OpenFoamImport, JobSchemaTakesImportKeysOnlyForImportJobs) {
+  json job = {{"kind", "import"}, {"scene", sceneDocument()}, {"case_dir", "case"}, {"times", "1:2"}};
+  EXPECT_EQ(rcfd::loadJob(job).kind, "import");
+  job.erase("case_dir");
+  EXPECT_THROW(rcfd::loadJob(job), rcfd::InputError);
+  json spray = {{"kind", "spray"}, {"scene", sceneDocument()}, {"database", "db.h5"}, {"duration", 1.0},
+                {"case_dir", "case"}};
+  try {
+    rcfd::loadJob(spray);
+    ADD_FAILURE() << "a spray job with case_dir was accepted";
+  } catch (const rcfd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("only import jobs take"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
