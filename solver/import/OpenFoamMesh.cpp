@@ -1,5 +1,6 @@
 #include "import/OpenFoamMesh.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <string>
 
