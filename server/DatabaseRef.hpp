@@ -1,6 +1,6 @@
 #pragma once
 /// \file DatabaseRef.hpp
-/// What a job's "database" reference points at on the server: the database.h5 of a database job
+/// What a job's "database" reference points at on the server: the database.h5 of a database or import job
 /// (usable once that job SUCCEEDED, pending while it is QUEUED or RUNNING) or an uploaded database.
 
 #include <filesystem>
@@ -25,5 +25,9 @@ struct DatabaseRef {
 /// worker starting a job accepted earlier), which sees all.
 DatabaseRef resolveDatabaseRef(JobStore& store, const ServerConfig& config, const std::string& ref,
                                const Caller* caller = nullptr);
+
+/// The directory an import job's `case_dir` names on the server: relative to `importRoot` and, with
+/// symbolic links and ".." resolved, inside it and existing. Empty when it is not (or no root is set).
+std::filesystem::path importCaseDirectory(const std::filesystem::path& importRoot, const std::string& caseDir);
 
 }  // namespace rcfd::server

@@ -246,7 +246,19 @@ Response JobsApi::submit(const Request& req, const Target& target, const Caller&
                                      "/scene_patch): run this scene with rcfd-solve instead"),
                           target.path);
   }
-  if (spec.kind != "database" && spec.database.empty())
+  if (spec.kind == "import") {
+    // An import reads a directory by name: only one inside the import root the operator named.
+    std::string why;
+    if (config_.importRoot.empty()) {
+      why = "this server reads no OpenFOAM case (start it with --import-root DIR); or import with "
+            "rcfd-solve import-openfoam and upload the database";
+    } else if (const auto dir = importCaseDirectory(config_.importRoot, spec.source.at("case_dir").get<std::string>());
+               dir.empty()) {
+      why = "must name a case directory inside the server's import root, relative to it";
+    }
+    if (!why.empty()) return invalidInput(InputError("job", "/case_dir", why), target.path);
+  }
+  if (spec.kind != "database" && spec.kind != "import" && spec.database.empty())
     return invalidInput(InputError("job", "/database",
                                    "required for " + spec.kind +
                                        " jobs: the id of a database job or an uploaded database"),

@@ -36,6 +36,9 @@ struct ServerConfig {
   int workers = 1;                    ///< concurrent solver processes (0: jobs stay QUEUED)
   int workerNice = 10;                ///< solvers run this much nicer than the server [0, 19]
   std::filesystem::path solverPath;   ///< the rcfd-solve executable
+  /// OpenFOAM cases import jobs may read: their case_dir is relative to it and stays inside it. Empty:
+  /// the server takes no import job (it reads no file a job names otherwise).
+  std::filesystem::path importRoot;
   std::uint64_t jsonBodyLimit = 1u << 20;            ///< bytes of a JSON request body
   std::uint64_t uploadLimit = 8ull << 30;            ///< bytes of an uploaded database
   std::chrono::seconds readTimeout{30};              ///< header and JSON body read timeout

@@ -93,6 +93,8 @@ void writeJobFile(JobStore& store, const ServerConfig& config, const JobRecord& 
     const DatabaseRef ref = resolveDatabaseRef(store, config, job.databaseRef);
     document["database"] = fs::absolute(ref.path).string();
   }
+  if (job.kind == "import" && document.contains("case_dir"))  // checked at submit: inside the import root
+    document["case_dir"] = importCaseDirectory(config.importRoot, document["case_dir"].get<std::string>()).string();
   {
     std::ofstream out(dir / "job.json.tmp");
     out << document.dump(2) << "\n";

@@ -142,6 +142,10 @@ int main(int argc, char** argv) {
                  "niceness added to solver processes, so HTTP answers do not wait behind them")
       ->capture_default_str()->check(CLI::Range(0, 19));
   app.add_option("--solver", solver, "rcfd-solve executable (default: beside rcfd-server)");
+  std::string importRoot;
+  app.add_option("--import-root", importRoot,
+                 "directory of OpenFOAM cases that import jobs may read (their case_dir is relative to it); "
+                 "without it the server takes no import job");
   app.add_option("--io-threads", ioThreads, "threads serving HTTP")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-body-bytes", maxBody, "limit of a JSON request body")->capture_default_str();
   app.add_option("--max-upload-bytes", maxUpload, "limit of a database upload")->capture_default_str();
@@ -221,6 +225,7 @@ int main(int argc, char** argv) {
     }
     config.pageTokenKey = pageTokenKey(config.dataDir);
     config.solverPath = solver.empty() ? defaultSolver() : std::filesystem::absolute(solver);
+    if (!importRoot.empty()) config.importRoot = std::filesystem::weakly_canonical(std::filesystem::absolute(importRoot));
     config.jsonBodyLimit = maxBody;
     config.uploadLimit = maxUpload;
     config.shutdownGrace = std::chrono::seconds(graceSeconds);
