@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs rcfd's build and test dependencies from Debian 12 packages (run as root, or with sudo).
 # Every dependency of the project is named here; docker/Dockerfile installs the same list.
-#   --build-only  leaves out the tools only the tests use (ParaView, Chromium, Node.js; the image of
-#                 docker/Dockerfile builds without tests)
+#   --build-only  leaves out the tools only the tests use (ParaView, Chromium, Node.js, Slurm; the image
+#                 of docker/Dockerfile builds without tests)
 set -euo pipefail
 test_tools=1
 for arg in "$@"; do
@@ -25,8 +25,7 @@ packages=(
   libspdlog-dev          # logging
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
-  slurm-wlm munge        # rcfd-server --executor slurm: sbatch/squeue/scancel, and the single-node test
-                         # cluster of tests/slurm (slurmctld, slurmd, munged)
+  zlib1g-dev             # the gzip-compressed files of OpenFOAM cases (rcfd-solve import-openfoam)
 )
 if [ "$test_tools" = 1 ]; then
   # The XDMF sidecars of the HDF5 outputs must open in ParaView: scripts/check-paraview.py opens them
@@ -38,6 +37,9 @@ if [ "$test_tools" = 1 ]; then
   # (tests/openapi). The machine's own Node.js (20) with its npm is kept where there is one; Debian's
   # otherwise.
   packages+=(chromium)
+  # rcfd-server --executor slurm calls sbatch, squeue and scancel of the site's Slurm; the tests start
+  # a single-node cluster of their own (tests/slurm: slurmctld, slurmd, munged).
+  packages+=(slurm-wlm munge)
   command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)
 fi
 missing=()
