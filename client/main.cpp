@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
   coverage->add_option("-o,--output", output, "output file")->required();
   auto* download = app.add_subcommand("download", "download an artifact of a job");
   download->add_option("ID", id)->required();
-  download->add_option("NAME", name, "database.h5, result.h5, summary.json, solver.log or NAME.svg")
+  download->add_option("NAME", name, "database.h5, result.h5, database.xmf, result.xmf, summary.json, solver.log or NAME.svg")
       ->required();
   download->add_option("-o,--output", output, "output file (default: NAME)");
   auto* health = app.add_subcommand("health", "check that the server answers (no token needed)");

@@ -29,8 +29,9 @@ constexpr int kDefaultPageSize = 50;
 constexpr int kMaxPageSize = 1000;
 constexpr std::size_t kMaxIdempotencyKey = 200;
 constexpr const char* kRetryAfterSeconds = "2";
-const char* const kFixedArtifacts[] = {"database.h5", "result.h5", "summary.json", "solver.log",
-                                       "job.json"};
+// The .xmf files are the XDMF sidecars through which ParaView opens database.h5 and result.h5.
+const char* const kFixedArtifacts[] = {"database.h5", "result.h5", "database.xmf", "result.xmf",
+                                       "summary.json", "solver.log", "job.json"};
 
 StringResponse notFound(const std::string& id, const Target& target) {
   return problem(http::status::not_found, "job-not-found", "Job not found",
@@ -121,6 +122,7 @@ std::string contentTypeFor(const std::string& name) {
   const auto ext = std::filesystem::path(name).extension().string();
   if (ext == ".h5") return "application/x-hdf5";
   if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".xmf") return "application/xml";
   if (ext == ".json") return "application/json";
   return "text/plain; charset=utf-8";
 }
@@ -516,8 +518,9 @@ Response JobsApi::artifact(const std::string& id, const std::string& name, const
                            const Caller& caller) {
   if (!isArtifactName(name))
     return problem(http::status::bad_request, "invalid-artifact-name", "Invalid artifact name",
-                   "\"" + name + "\" is not an artifact name: database.h5, result.h5, summary.json, "
-                   "solver.log, job.json or a figure NAME.svg; paths are never accepted",
+                   "\"" + name + "\" is not an artifact name: database.h5, result.h5, their ParaView "
+                   "sidecars database.xmf and result.xmf, summary.json, solver.log, job.json or a figure "
+                   "NAME.svg; paths are never accepted",
                    target.path);
   const auto job = visibleJob(id, caller);
   if (!job) return notFound(id, target);

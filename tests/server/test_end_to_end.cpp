@@ -202,6 +202,12 @@ TEST_F(EndToEnd, UploadSprayCoverageCsvAndH5EqualResultH5) {
   const auto artifacts = job.at("artifacts");
   EXPECT_NE(std::find(artifacts.begin(), artifacts.end(), "result.h5"), artifacts.end());
   EXPECT_NE(std::find(artifacts.begin(), artifacts.end(), "summary.json"), artifacts.end());
+  // The ParaView sidecar of result.h5 downloads beside it and names it by relative path.
+  EXPECT_NE(std::find(artifacts.begin(), artifacts.end(), "result.xmf"), artifacts.end());
+  const Reply sidecar = server->get("/v1/jobs/" + id + "/artifacts/result.xmf");
+  EXPECT_EQ(sidecar.status, 200);
+  EXPECT_EQ(sidecar.header("content-type"), "application/xml");
+  EXPECT_NE(sidecar.body.find("result.h5:/"), std::string::npos);
 }
 
 /// The nice value of a process (/proc/PID/stat field 19).
