@@ -135,7 +135,7 @@ Response Router::route(const Request& req, const Target& target, const std::opti
   if (s.size() >= 2 && s[1] == "databases") {
     if (s.size() == 2) {
       if (get) return databases_.list(who);
-      return methodNotAllowed(target, "GET, POST");  // uploads are routed by the session
+      return methodNotAllowed(target, "GET, POST");  // uploads are routed by HttpSession (streamed bodies)
     }
     if (s.size() == 3) {
       if (!get) return methodNotAllowed(target, "GET");

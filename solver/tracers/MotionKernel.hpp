@@ -17,10 +17,10 @@
 ///  - **Two wall tests before the exact one** (moveLanes(), MotionKernelBlock.cpp): a move shorter
 ///    than its cell's wall reach, or clear of every half-space of the open region near its cell and of
 ///    the plates, cannot meet a wall; only the others take ReferenceMotion's exact segment test.
-///  - **Sub-steps three ways**: most tracers take one sub-step (the block's first round); a block in
-///    which most lanes need more takes them in place, every lane in every round (advanceInPlace(),
+///  - **Sub-steps three ways**: most tracers take one sub-step (the block's first pass); a block in
+///    which most lanes need more takes them in place, every lane in every pass (advanceInPlace(),
 ///    lanes done stand still); otherwise its few such lanes are deferred and gathered across blocks
-///    until 64 move together (defer(), finishDeferred()), so later rounds run on full vectors.
+///    until 64 move together (defer(), finishDeferred()), so later passes run on full vectors.
 ///  - **The next step's cells** are found for a chunk of blocks while its positions are in cache
 ///    (TracerContext::nextTracerCell), with the one CellIndexer every user of a tracer's cell shares.
 /// Dynamic chunks of 16 blocks balance the threads: sub-stepped and near-wall tracers cluster.
