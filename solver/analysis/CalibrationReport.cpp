@@ -8,6 +8,7 @@
 
 #include "analysis/CalibrationFigures.hpp"
 #include "analysis/KsDistance.hpp"
+#include "geometry/Apparatus.hpp"
 #include "analysis/StayComparison.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
@@ -65,7 +66,7 @@ nlohmann::json optionalNumber(const std::optional<double>& v) { return v ? nlohm
 /// share of the cell inside the zone (4 x 4 x 4 points per cell), over the volume of one particle.
 double fieldHoldup(const Scene& scene, const CartesianGrid& grid, const std::vector<float>& alpha,
                    const std::vector<float>& fluid) {
-  const SprayZone zone(scene.spray.spray_zone);
+  const SprayZone zone(scene.spray.spray_zone, Apparatus(scene.apparatus));
   const auto& p = scene.particles;
   const double particleVolume = 3.14159265358979323846 / 6.0 * p.diameter * p.diameter * p.diameter;
   constexpr int kPoints = 4;
@@ -319,6 +320,7 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
   nlohmann::json reference = {{"available", in.reference.missing.empty()},
                               {"missing", in.reference.missing},
                               {"scores_not_computed", notComputed}};
+  if (!in.reference.zoneMismatch.empty()) reference["zone_mismatch"] = in.reference.zoneMismatch;
   if (refRtd) {
     double sum = 0.0;
     for (const double t : in.reference.durations) sum += t;

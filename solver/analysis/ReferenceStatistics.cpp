@@ -1,6 +1,11 @@
 #include "analysis/ReferenceStatistics.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
@@ -20,6 +25,40 @@ std::vector<double> readNonNegative(const h5::File& f, const std::string& path, 
   return v;
 }
 
+/// The spray zone of a scene document, its keys' defaults where absent; nullopt without a `/spray/spray_zone`.
+std::optional<SprayZoneSpec> sprayZoneOf(const std::string& sceneJson) {
+  const auto doc = nlohmann::json::parse(sceneJson, nullptr, false);
+  const auto pointer = nlohmann::json::json_pointer("/spray/spray_zone");
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains(pointer) || !doc.at(pointer).is_object()) return std::nullopt;
+  const auto& z = doc.at(pointer);
+  SprayZoneSpec spec;
+  try {
+    if (z.contains("apex")) spec.apex = Vec3(z["apex"].at(0).get<double>(), z["apex"].at(1).get<double>(), z["apex"].at(2).get<double>());
+    spec.half_angle_deg = z.value("half_angle_deg", spec.half_angle_deg);
+    spec.y_min = z.value("y_min", spec.y_min);
+    spec.y_max = z.value("y_max", spec.y_max);
+    spec.line_of_sight = z.value("line_of_sight", spec.line_of_sight);
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
+  return spec;
+}
+
+std::string describe(const SprayZoneSpec& z) {
+  std::ostringstream s;
+  s.precision(6);
+  s << "apex (" << z.apex.x() << ", " << z.apex.y() << ", " << z.apex.z() << ") m, half-angle " << z.half_angle_deg
+    << " deg, y " << z.y_min << "-" << z.y_max << " m" << (z.line_of_sight ? ", line of sight" : "");
+  return s.str();
+}
+
+bool sameZone(const SprayZoneSpec& a, const SprayZoneSpec& b) {
+  auto near = [](double x, double y) { return std::abs(x - y) <= 1e-12 * std::max({1.0, std::abs(x), std::abs(y)}); };
+  return near(a.apex.x(), b.apex.x()) && near(a.apex.y(), b.apex.y()) && near(a.apex.z(), b.apex.z()) &&
+         near(a.half_angle_deg, b.half_angle_deg) && near(a.y_min, b.y_min) && near(a.y_max, b.y_max) &&
+         a.line_of_sight == b.line_of_sight;
+}
+
 }  // namespace
 
 double ReferenceStatistics::holdupMean() const {
@@ -35,10 +74,18 @@ double referenceMembers(const ReferenceStatistics& reference, double bedMass, do
   return bedMass / particleMass;
 }
 
-ReferenceStatistics readReferenceStatistics(const std::string& path) {
+ReferenceStatistics readReferenceStatistics(const std::string& path, const SprayZoneSpec* zone) {
   namespace L = reference_layout;
   ReferenceStatistics r;
   h5::File f(path, h5::File::Mode::ReadOnly);
+  if (zone && f.exists("/scene") && (f.exists(L::durations) || f.exists(L::holdup))) {
+    if (const auto counted = sprayZoneOf(f.readString("/scene")); counted && !sameZone(*counted, *zone)) {
+      r.zoneMismatch = "the database's reference was counted in the spray zone " + describe(*counted) +
+                       ", the job's is " + describe(*zone) + "; its stays and holdup are not compared";
+      r.missing = {L::durations, L::holdup};
+      return r;
+    }
+  }
   if (f.exists(L::durations)) {
     r.durations = readNonNegative(f, path, L::durations);
     // Optional attributes: absent ones stay 0 (unknown); present ones must be finite and > 0.

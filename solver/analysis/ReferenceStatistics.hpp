@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "scene/Scene.hpp"
+
 namespace rcfd::analysis {
 
 namespace reference_layout {
@@ -37,6 +39,9 @@ struct ReferenceStatistics {
   double members = 0.0;           ///< members whose stays were recorded (0: unknown)
   double period = 0.0;            ///< [s] over which they were recorded (0: unknown)
   std::vector<std::string> missing;  ///< datasets not found (their names from reference_layout)
+  /// Why the stays and the holdup were left out though present: the database's scene counted them in
+  /// another spray zone than the job's (empty when they were kept).
+  std::string zoneMismatch;
 
   bool hasDurations() const { return !durations.empty(); }
   bool hasHoldup() const { return !holdup.empty(); }
@@ -53,6 +58,9 @@ double referenceMembers(const ReferenceStatistics& reference, double bedMass, do
 /// Reads the reference statistics of a database file. Absent datasets go into `missing`; present but
 /// malformed ones (non-finite or negative values, empty, missing or non-positive dt) are an
 /// rcfd::InputError naming the file and dataset.
-ReferenceStatistics readReferenceStatistics(const std::string& databasePath);
+/// With `zone`, stays and holdup counted in another spray zone (the one in the database's `/scene`, which
+/// the database job counted them in) are left out and `zoneMismatch` says why: they would be compared
+/// with tracers counted elsewhere.
+ReferenceStatistics readReferenceStatistics(const std::string& databasePath, const SprayZoneSpec* zone = nullptr);
 
 }  // namespace rcfd::analysis

@@ -5,6 +5,7 @@
 #include "analysis/ReferenceStatistics.hpp"
 #include "analysis/SeriesSpectrum.hpp"
 #include "core/Errors.hpp"
+#include "geometry/Apparatus.hpp"
 #include "core/Hdf5.hpp"
 #include "recurrence/SamplingCriterion.hpp"
 
@@ -18,7 +19,7 @@ nlohmann::json numberOrNull(double v) { return std::isfinite(v) ? nlohmann::json
 ReferenceRecorder::ReferenceRecorder(const Scene& scene, const CartesianGrid& grid, std::size_t parcels, double dt,
                                      std::int64_t referenceStart)
     : scene_(scene),
-      zone_(scene.spray.spray_zone),
+      zone_(scene.spray.spray_zone, Apparatus(scene.apparatus)),
       dt_(dt),
       referenceStart_(referenceStart),
       particlesPerParcel_(std::pow(scene.dem.coarse_graining, 3)),

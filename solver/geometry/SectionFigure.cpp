@@ -191,7 +191,7 @@ void paint(SectionPainter& pen, const Scene& scene, const Apparatus& app, const 
 SvgDocument drawSection(const Scene& scene) {
   const Apparatus app(scene.apparatus);
   const CartesianGrid grid = makeGrid(app, scene.grid);
-  const SprayZone zone(scene.spray.spray_zone);
+  const SprayZone zone(scene.spray.spray_zone, app);
   const Vector3d lo = app.lowerCorner(), hi = app.upperCorner();
   const double extent = std::max(hi.x() - lo.x(), hi.y() - lo.y());
   const double step = niceStep(extent / 6.0);

@@ -6,6 +6,7 @@
 #include <vector>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "core/Errors.hpp"
 #include "geometry/Apparatus.hpp"
@@ -67,6 +68,53 @@ SprayZone::SprayZone(const SprayZoneSpec& spec) : spec_(spec) {
   tanHalfAngle_ = std::tan(spec.half_angle_deg * std::numbers::pi / 180.0);
 }
 
+SprayZone::SprayZone(const SprayZoneSpec& spec, const Apparatus& apparatus) : SprayZone(spec) {
+  if (!spec.line_of_sight) return;
+  for (const auto& hole : apparatus.holes()) {
+    Shadow s{hole[0].x(), hole[0].x(), hole[0].y(), hole[0].y()};
+    for (const auto& p : hole) {
+      s.x0 = std::min(s.x0, p.x()), s.x1 = std::max(s.x1, p.x());
+      s.y0 = std::min(s.y0, p.y()), s.y1 = std::max(s.y1, p.y());
+    }
+    // A plate wholly below the apex or above the zone shadows nothing in it.
+    if (s.y1 > spec.apex.y() && s.y0 < spec.y_max) shadows_.push_back(s);
+  }
+}
+
+// The segment from the apex a to a point p at height y > a.y passes the heights y' in [max(y0, a.y),
+// min(y1, y)] of the plate at x' = a.x + (p.x - a.x) h / H, h = y' - a.y, H = y - a.y. It meets the plate
+// when those x' reach [x0, x1]; for a given point that is a test on the two ends, and over the points
+// of a height it is one interval (each h maps [x0, x1] to dx in [c0 H / h, c1 H / h]).
+bool SprayZone::shadowed(double x, double y) const {
+  const double H = y - spec_.apex.y();
+  if (!(H > 0.0)) return false;
+  const double dx = x - spec_.apex.x();
+  for (const Shadow& s : shadows_) {
+    const double h0 = std::max(s.y0 - spec_.apex.y(), 0.0), h1 = std::min(s.y1, y) - spec_.apex.y();
+    if (!(h1 >= h0)) continue;
+    const double c0 = (s.x0 - spec_.apex.x()) * H, c1 = (s.x1 - spec_.apex.x()) * H;
+    const double lo = std::min(dx * h0, dx * h1), hi = std::max(dx * h0, dx * h1);
+    if (lo <= c1 && hi >= c0) return true;
+  }
+  return false;
+}
+
+std::pair<double, double> SprayZone::shadowAt(const Shadow& s, double y) const {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double H = y - spec_.apex.y();
+  const double h0 = std::max(s.y0 - spec_.apex.y(), 0.0), h1 = std::min(s.y1, y) - spec_.apex.y();
+  if (!(H > 0.0) || !(h1 > 0.0) || h1 < h0) return {inf, -inf};
+  const double c0 = (s.x0 - spec_.apex.x()) * H, c1 = (s.x1 - spec_.apex.x()) * H;
+  // The ends of the union over h in [h0, h1] of [c0 / h, c1 / h]; h -> 0 sends a non-zero end to infinity.
+  auto end = [&](double c, bool lower) {
+    if (h0 > 0.0) return lower ? std::min(c / h0, c / h1) : std::max(c / h0, c / h1);
+    if (c == 0.0) return 0.0;
+    if (lower) return c > 0.0 ? c / h1 : -inf;
+    return c < 0.0 ? c / h1 : inf;
+  };
+  return {spec_.apex.x() + end(c0, true), spec_.apex.x() + end(c1, false)};
+}
+
 double SprayZone::radiusAt(double y) const {
   return y <= spec_.apex.y() ? 0.0 : (y - spec_.apex.y()) * tanHalfAngle_;
 }
@@ -94,14 +142,35 @@ double SprayZone::volumeInside(const Apparatus& apparatus, int slices) const {
     }
     const double r = radiusAt(y);
     double a = diskRectangleArea(cx, cz, r, xl, xr, 0.0, depth);
+    // The x-intervals left out at this height: the plates themselves and their shadows, merged so
+    // that an overlap is subtracted once.
+    std::vector<std::pair<double, double>> out;
     for (const auto& hole : apparatus.holes()) {
       double hx0 = hole[0].x(), hx1 = hole[0].x(), hy0 = hole[0].y(), hy1 = hole[0].y();
       for (const auto& p : hole) {
         hx0 = std::min(hx0, p.x()), hx1 = std::max(hx1, p.x());
         hy0 = std::min(hy0, p.y()), hy1 = std::max(hy1, p.y());
       }
-      if (y > hy0 && y < hy1) a -= diskRectangleArea(cx, cz, r, std::max(hx0, xl), std::min(hx1, xr), 0.0, depth);
+      if (y > hy0 && y < hy1) out.emplace_back(hx0, hx1);
     }
+    for (const Shadow& s : shadows_) out.push_back(shadowAt(s, y));
+    std::sort(out.begin(), out.end());
+    bool running = false;
+    double runLo = 0.0, runHi = 0.0;
+    auto subtract = [&] {
+      const double lo = std::max(runLo, xl), hi = std::min(runHi, xr);
+      if (running && hi > lo) a -= diskRectangleArea(cx, cz, r, lo, hi, 0.0, depth);
+    };
+    for (const auto& [lo, hi] : out) {
+      if (!(hi > lo)) continue;
+      if (!running || lo > runHi) {
+        subtract();
+        running = true, runLo = lo, runHi = hi;
+      } else {
+        runHi = std::max(runHi, hi);
+      }
+    }
+    subtract();
     return std::max(0.0, a);
   };
   // Split at the heights where the open section changes shape (plate edges, outline corners), so

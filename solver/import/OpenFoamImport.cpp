@@ -117,7 +117,7 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
   const CartesianGrid grid = makeGrid(apparatus, scene.grid);
   const std::vector<double> open = openFractions(apparatus, grid);
   CartesianMapping mapping(grid, std::vector<float>(open.begin(), open.end()));
-  const SprayZone zone(scene.spray.spray_zone);
+  const SprayZone zone(scene.spray.spray_zone, apparatus);
 
   std::vector<CellGeometry> meshes;
   double meshVolume = 0.0, outsideVolume = 0.0;

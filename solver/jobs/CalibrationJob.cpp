@@ -88,7 +88,9 @@ class CalibrationJob final : public JobRunner {
     const bool parallelOverD0 = parallelMode(job.source) == "d0_values";
 
     // Reference statistics first: the recurrence setup may rewrite the file (stored matrix).
-    const analysis::ReferenceStatistics reference = analysis::readReferenceStatistics(job.database);
+    const analysis::ReferenceStatistics reference =
+        analysis::readReferenceStatistics(job.database, &scene.spray.spray_zone);
+    if (!reference.zoneMismatch.empty()) spdlog::warn("{}: {}", job.database, reference.zoneMismatch);
     for (const auto& m : reference.missing) {
       spdlog::warn("{}: no {} (reference statistics of the full simulation); scores that need it are not computed",
                    job.database, m);

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "core/Errors.hpp"
+#include "geometry/Apparatus.hpp"
 #include "jobs/Cancellation.hpp"
 #include "tracers/TracerEffect.hpp"
 
@@ -103,7 +104,7 @@ RecurrenceSetup prepareRecurrence(const Scene& scene, const std::string& databas
     storage.progress = [&](double f) { report(readOnce, readOnce + work.matrix, f); };
     if (!setup.database) setup.database = FieldDatabase::open(databasePath, storage);
   }
-  setup.frameSpacing = frameSpacing(*setup.database, SprayZone(scene.spray.spray_zone));
+  setup.frameSpacing = frameSpacing(*setup.database, SprayZone(scene.spray.spray_zone, Apparatus(scene.apparatus)));
   if (const std::string warning = sparseFramesWarning(setup.frameSpacing); !warning.empty()) spdlog::warn("{}", warning);
   if (!PathGeneratorRegistry::contains(scene.rcfd.path.type)) {
     throw InputError("scene", "/rcfd/path/type", PathGeneratorRegistry::unknownNameMessage(scene.rcfd.path.type));

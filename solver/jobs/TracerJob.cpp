@@ -44,10 +44,14 @@ nlohmann::json stayComparison(const JobSpec& job, const Scene& scene, const std:
                               std::int64_t steps) {
   analysis::ReferenceStatistics reference;
   try {
-    reference = analysis::readReferenceStatistics(job.database);
+    reference = analysis::readReferenceStatistics(job.database, &scene.spray.spray_zone);
   } catch (const InputError& e) {  // a damaged reference must not cost the finished run its summary
     spdlog::warn("no stay comparison: {}", e.what());
     return {{"error", e.what()}};
+  }
+  if (!reference.zoneMismatch.empty()) {
+    spdlog::warn("no stay comparison: {}", reference.zoneMismatch);
+    return {{"error", reference.zoneMismatch}};
   }
   h5::File result(resultPath, h5::File::Mode::ReadOnly);
   const char* counts = "/residence_time/duration_steps_counts";

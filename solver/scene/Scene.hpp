@@ -83,6 +83,9 @@ struct SprayZoneSpec {
   double half_angle_deg = 17.0;     ///< [deg]
   double y_min = 0.02;              ///< [m]
   double y_max = 0.1;               ///< [m]
+  /// Only the part of the cone a straight line from the apex reaches without crossing a draft plate:
+  /// the region the spray sees, not the bed behind or on top of a plate.
+  bool line_of_sight = false;
 };
 
 struct SpraySpec {

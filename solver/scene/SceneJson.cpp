@@ -102,6 +102,7 @@ Scene sceneFromJson(const json& document) {
   read(zone, "half_angle_deg", s.spray.spray_zone.half_angle_deg);
   read(zone, "y_min", s.spray.spray_zone.y_min);
   read(zone, "y_max", s.spray.spray_zone.y_max);
+  read(zone, "line_of_sight", s.spray.spray_zone.line_of_sight);
 
   const json& d = section(document, "dem");
   read(d, "coarse_graining", s.dem.coarse_graining);
@@ -192,7 +193,8 @@ json sceneToJson(const Scene& s) {
                   {"droplet_diameter", sp.droplet_diameter}, {"droplet_density", sp.droplet_density},
                   {"parcels_per_s", sp.parcels_per_s}, {"deposition_model", sp.deposition_model},
                   {"spray_zone", {{"apex", vec(sp.spray_zone.apex)}, {"half_angle_deg", sp.spray_zone.half_angle_deg},
-                                  {"y_min", sp.spray_zone.y_min}, {"y_max", sp.spray_zone.y_max}}}};
+                                  {"y_min", sp.spray_zone.y_min}, {"y_max", sp.spray_zone.y_max},
+                                  {"line_of_sight", sp.spray_zone.line_of_sight}}}};
   const auto& d = s.dem;
   doc["dem"] = {{"coarse_graining", d.coarse_graining}, {"time_step", d.time_step},
                 {"max_rayleigh_fraction", d.max_rayleigh_fraction},

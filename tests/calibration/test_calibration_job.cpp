@@ -25,6 +25,7 @@
 #include "core/Errors.hpp"
 #include "jobs/JobRunner.hpp"
 #include "recurrence/PathFile.hpp"
+#include "scene/SceneJson.hpp"
 
 using namespace rcfd;
 using namespace rcfd::test;
@@ -275,6 +276,45 @@ TEST(CalibrationJob, ReferenceStatisticsAreUsed) {
               1e-12);
   // The scores not depending on the reference are those of the run without it.
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(s["d0"][i]["penalty"], first["d0"][i]["penalty"]);
+}
+
+TEST(CalibrationJob, AReferenceCountedInAnotherSprayZoneIsNotCompared) {
+  // The database job counted its stays in the zone of the database's /scene; a job whose scene moved
+  // the zone (or clipped it to the apex's line of sight) would compare tracers counted elsewhere.
+  const fs::path dir = scratch("zone");
+  JobSpec job = makeJob(dir, {0.0, 1e-2});
+  auto writeReference = [&](const SprayZoneSpec& zone) {
+    h5::File db(job.database, h5::File::Mode::ReadWrite);
+    Scene counted = job.scene;
+    counted.spray.spray_zone = zone;
+    if (db.exists("/scene")) H5Ldelete(db.id(), "/scene", H5P_DEFAULT);
+    db.writeString("/scene", sceneToJson(counted).dump());
+    for (const char* name : {analysis::reference_layout::durations, analysis::reference_layout::holdup})
+      if (db.exists(name)) H5Ldelete(db.id(), name, H5P_DEFAULT);
+    db.write(analysis::reference_layout::durations, std::vector<double>{0.01, 0.02, 0.03});
+    db.write(analysis::reference_layout::holdup, std::vector<double>{1.0, 2.0});
+    db.setAttribute(analysis::reference_layout::holdup, "dt", kDt);
+  };
+  writeReference(job.scene.spray.spray_zone);
+  const auto same = analysis::readReferenceStatistics(job.database, &job.scene.spray.spray_zone);
+  EXPECT_TRUE(same.zoneMismatch.empty());
+  EXPECT_EQ(same.durations.size(), 3u);
+  SprayZoneSpec clipped = job.scene.spray.spray_zone;
+  clipped.line_of_sight = true;
+  for (const SprayZoneSpec& other : {clipped, [&] { auto z = job.scene.spray.spray_zone; z.y_max = 0.015; return z; }()}) {
+    writeReference(other);
+    const auto r = analysis::readReferenceStatistics(job.database, &job.scene.spray.spray_zone);
+    EXPECT_FALSE(r.zoneMismatch.empty());
+    EXPECT_TRUE(r.durations.empty());
+    EXPECT_TRUE(r.holdup.empty());
+    // Without a zone to hold it to, the reference is read as it is.
+    EXPECT_EQ(analysis::readReferenceStatistics(job.database).durations.size(), 3u);
+  }
+  const json s = run(job, dir / "out");
+  EXPECT_FALSE(s["reference"]["available"].get<bool>());
+  EXPECT_NE(s["reference"]["zone_mismatch"].get<std::string>().find("y 0-0.015 m"), std::string::npos)
+      << s["reference"]["zone_mismatch"];
+  for (const auto& d : s["d0"]) EXPECT_TRUE(d["rtd_ks_distance"].is_null());
 }
 
 TEST(CalibrationJob, BadReferenceIsAnInputErrorNamingTheDataset) {

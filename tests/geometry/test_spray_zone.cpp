@@ -118,6 +118,34 @@ TEST(SprayZone, VolumeInsideTheApparatus) {
   EXPECT_NEAR(vo, mc, 4 * sigma);
 }
 
+TEST(SprayZone, DraftPlatesShadowTheZoneSeenFromItsApex) {
+  // ProCell's plates: inner faces at x = +-22.5 mm, 2 mm thick, 35-95 mm high; the paper's cone (apex at
+  // y = 0) reaches them at y = 73.6 mm and is 30.6 mm wide at y_max = 0.1 m.
+  SprayZoneSpec spec = paperZone();
+  spec.line_of_sight = true;
+  const Apparatus plates(test::procellSpec(true));
+  const SprayZone seen(spec, plates);
+  const SprayZone cone(paperZone(), plates);
+  for (const double side : {-1.0, 1.0}) {
+    EXPECT_TRUE(seen.contains({side * 0.020, 0.090, 0.1}));   // in the tube
+    EXPECT_FALSE(seen.contains({side * 0.026, 0.090, 0.1}));  // behind the plate
+    EXPECT_TRUE(cone.contains({side * 0.026, 0.090, 0.1}));
+    EXPECT_FALSE(seen.contains({side * 0.026, 0.099, 0.1}));  // above the annulus: the ray meets the plate at 85.7 mm
+    EXPECT_TRUE(seen.contains({side * 0.023, 0.099, 0.1}));   // above the plate's top, seen past its edge (96.8 mm)
+    EXPECT_FALSE(seen.contains({side * 0.023, 0.097, 0.1}));  // just below that line (94.9 mm)
+  }
+  // The volume leaves the shadows out, and agrees with the points the zone contains.
+  const double v = seen.volumeInside(plates);
+  EXPECT_LT(v, cone.volumeInside(plates));
+  const auto [mc, sigma] = monteCarloInside(seen, plates);
+  EXPECT_NEAR(v, mc, 4 * sigma);
+  // Without plates nothing shadows the zone: the same volume, the same points.
+  const Apparatus open(test::procellSpec(false));
+  const SprayZone seenOpen(spec, open);
+  EXPECT_DOUBLE_EQ(seenOpen.volumeInside(open), SprayZone(paperZone()).volumeInside(open));
+  EXPECT_TRUE(seenOpen.contains({0.026, 0.090, 0.1}));
+}
+
 TEST(SprayZone, RefusesInvalidSpecs) {
   using V = std::vector<std::string>;
   auto z = paperZone();

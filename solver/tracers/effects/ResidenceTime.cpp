@@ -15,7 +15,7 @@ namespace {
 
 class ResidenceTimeEffect final : public TracerEffect {
  public:
-  explicit ResidenceTimeEffect(TracerContext& ctx) : zone_(ctx.scene.spray.spray_zone), stays_(ctx.cloud.size()) {
+  explicit ResidenceTimeEffect(TracerContext& ctx) : zone_(ctx.scene.spray.spray_zone, ctx.apparatus), stays_(ctx.cloud.size()) {
     for (std::size_t i = 0; i < ctx.cloud.size(); ++i) {
       if (zone_.contains(ctx.cloud.position(i))) stays_.startInside(i);
     }
