@@ -290,7 +290,8 @@ SvgDocument drawSection(const Scene& scene) {
   yRow -= rowPx / scale;
   doc.text(x0, yRow, "spray zone volume " + fmt(zone.volume() * 1e6) + " mL", 11);
   yRow -= rowPx / scale;
-  doc.text(x0, yRow, "  of which in the open region " + fmt(zone.volumeInside(app) * 1e6) + " mL", 11);
+  const std::string where = zs.line_of_sight ? "  of which open and in the apex's sight " : "  of which in the open region ";
+  doc.text(x0, yRow, where + fmt(zone.volumeInside(app) * 1e6) + " mL", 11);
   return doc;
 }
 

@@ -29,16 +29,21 @@ class SprayZone {
   /// True if p lies in the truncated cone (boundary included) and, with `line_of_sight`, is not in a
   /// plate's shadow.
   bool contains(const Eigen::Vector3d& p) const { return contains(p.x(), p.y(), p.z()); }
-  /// The same test on coordinates; the cone's test is branch-free, so loops over many points vectorise
-  /// when nothing shadows the zone.
+  /// The same test on coordinates.
   bool contains(double x, double y, double z) const {
+    return shadows_.empty() ? inCone(x, y, z) : inCone(x, y, z) && !shadowed(x, y);
+  }
+
+  /// The truncated cone alone, branch-free, so loops over many points vectorise; with hasShadows() the
+  /// points it accepts are then tested with shadowed().
+  bool inCone(double x, double y, double z) const {
     const double dx = x - spec_.apex.x(), dz = z - spec_.apex.z();
     const double above = y - spec_.apex.y();
     const double r = (above > 0.0 ? above : 0.0) * tanHalfAngle_;  // radiusAt(y)
-    const bool inCone = (y >= spec_.y_min) & (y <= spec_.y_max) & (dx * dx + dz * dz <= r * r);
-    return shadows_.empty() ? inCone : inCone && !shadowed(x, y);
+    return (y >= spec_.y_min) & (y <= spec_.y_max) & (dx * dx + dz * dz <= r * r);
   }
-
+  /// True if plates shadow the zone (`line_of_sight` and a plate between y_min and y_max).
+  bool hasShadows() const { return !shadows_.empty(); }
   /// True if the segment from the apex to (x, y) (any z: the plates span the depth) meets a plate.
   bool shadowed(double x, double y) const;
 

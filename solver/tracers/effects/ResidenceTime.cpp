@@ -48,9 +48,13 @@ class ResidenceTimeEffect final : public TracerEffect {
         // Who is inside, and who entered or left (few): only those change the books.
         std::int64_t in[kBlock], changed[kBlock];
         std::int64_t insideHere = 0, changes = 0;
+#pragma omp simd
+        for (int k = 0; k < count; ++k) in[k] = zone_.inCone(x[i0 + k], y[i0 + k], z[i0 + k]);
+        if (zone_.hasShadows()) {
+          for (int k = 0; k < count; ++k) in[k] = in[k] && !zone_.shadowed(x[i0 + k], y[i0 + k]);
+        }
 #pragma omp simd reduction(+ : insideHere, changes)
         for (int k = 0; k < count; ++k) {
-          in[k] = zone_.contains(x[i0 + k], y[i0 + k], z[i0 + k]);
           changed[k] = in[k] != std::int64_t(entry[i0 + k] != kOutside);
           insideHere += in[k], changes += changed[k];
         }
