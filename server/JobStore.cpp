@@ -517,6 +517,20 @@ std::vector<CoverageBin> JobStore::coverage(const std::string& id) {
   return out;
 }
 
+namespace {
+/// A row of "SELECT id, path, bytes, frames, created_at, owner FROM databases".
+DatabaseRecord databaseRow(const Statement& s) {
+  DatabaseRecord d;
+  d.id = s.text(0);
+  d.path = s.text(1);
+  d.bytes = s.integer(2);
+  d.frames = static_cast<int>(s.integer(3));
+  d.createdAt = s.text(4);
+  d.owner = s.text(5);
+  return d;
+}
+}  // namespace
+
 void JobStore::insertDatabase(const DatabaseRecord& db) {
   std::lock_guard lock(mutex_);
   Statement s(db_,
@@ -531,14 +545,7 @@ std::optional<DatabaseRecord> JobStore::database(const std::string& id) {
   Statement s(db_, "SELECT id, path, bytes, frames, created_at, owner FROM databases WHERE id = ?1");
   s.bind(1, id);
   if (!s.step()) return std::nullopt;
-  DatabaseRecord d;
-  d.id = s.text(0);
-  d.path = s.text(1);
-  d.bytes = s.integer(2);
-  d.frames = static_cast<int>(s.integer(3));
-  d.createdAt = s.text(4);
-  d.owner = s.text(5);
-  return d;
+  return databaseRow(s);
 }
 
 std::vector<DatabaseRecord> JobStore::listDatabases(const std::string& owner) {
@@ -548,16 +555,7 @@ std::vector<DatabaseRecord> JobStore::listDatabases(const std::string& owner) {
               "ORDER BY rowid");
   s.bind(1, owner);
   std::vector<DatabaseRecord> out;
-  while (s.step()) {
-    DatabaseRecord d;
-    d.id = s.text(0);
-    d.path = s.text(1);
-    d.bytes = s.integer(2);
-    d.frames = static_cast<int>(s.integer(3));
-    d.createdAt = s.text(4);
-    d.owner = s.text(5);
-    out.push_back(std::move(d));
-  }
+  while (s.step()) out.push_back(databaseRow(s));
   return out;
 }
 

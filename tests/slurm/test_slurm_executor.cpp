@@ -205,6 +205,32 @@ class SlurmExecutor : public ::testing::Test {
     return -1;
   }
 
+  /// A job whose server was killed (-9) while its solver ran in Slurm.
+  struct OrphanedJob {
+    std::string id, slurmJobId;
+  };
+  OrphanedJob killServerMidJob(int seed) {
+    OrphanedJob orphan;
+    auto server = startSlurmServer();
+    orphan.id = submit(*server, sprayJob(upload(*server), 12.0, seed));
+    const pid_t solver = frozenSolverWithCheckpoint(orphan.id);
+    EXPECT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, orphan.id);
+    orphan.slurmJobId = storedSlurmJobId(dataDir(), orphan.id);
+    server->stop(SIGKILL);
+    if (solver > 0) ::kill(solver, SIGCONT);
+    return orphan;
+  }
+  /// A new server follows the orphan's Slurm job to the end: its first attempt, nothing submitted again.
+  std::unique_ptr<ServerProcess> expectFollowedToTheEnd(const OrphanedJob& orphan) {
+    auto server = startSlurmServer();
+    const auto done = pollJob(*server, orphan.id, isFinal);
+    EXPECT_EQ(done.at("state"), "SUCCEEDED") << done.dump(2) << eventReasons(*server, orphan.id);
+    EXPECT_EQ(done.at("attempt"), 1);
+    EXPECT_EQ(storedSlurmJobId(dataDir(), orphan.id), orphan.slurmJobId);
+    EXPECT_EQ(slurmJobsNamed("rcfd-" + orphan.id), std::vector<std::string>{orphan.slurmJobId + " COMPLETED"});
+    return server;
+  }
+
   std::unique_ptr<TempDir> tmp_;
   nlohmann::json scene_;
   std::string node_;
@@ -368,24 +394,10 @@ TEST_F(SlurmExecutor, NodeDownMidJobRequeuesAndTheJobFinishesWhenTheNodeIsBack) 
 // kill -9 of the server mid-job: the job goes on in Slurm, the restarted server finds it by its stored
 // Slurm id and follows it to the end, and nothing is submitted twice.
 TEST_F(SlurmExecutor, ServerKilledMidJobFollowsTheSameSlurmJobToTheEnd) {
-  std::string id, slurmJobId;
-  {
-    auto server = startSlurmServer();
-    id = submit(*server, sprayJob(upload(*server), 12.0, 5));
-    const pid_t solver = frozenSolverWithCheckpoint(id);
-    ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, id);
-    slurmJobId = storedSlurmJobId(dataDir(), id);
-    server->stop(SIGKILL);
-    ::kill(solver, SIGCONT);
-    ASSERT_FALSE(slurmJobId.empty());
-    EXPECT_EQ(slurmJobsNamed("rcfd-" + id), std::vector<std::string>{slurmJobId + " RUNNING"});
-  }
-  auto server = startSlurmServer();
-  const auto done = pollJob(*server, id, isFinal);
-  EXPECT_EQ(done.at("state"), "SUCCEEDED") << done.dump(2) << eventReasons(*server, id);
-  EXPECT_EQ(done.at("attempt"), 1);
-  EXPECT_EQ(storedSlurmJobId(dataDir(), id), slurmJobId);
-  EXPECT_EQ(slurmJobsNamed("rcfd-" + id), std::vector<std::string>{slurmJobId + " COMPLETED"});
+  const OrphanedJob orphan = killServerMidJob(5);
+  ASSERT_FALSE(orphan.slurmJobId.empty());
+  EXPECT_EQ(slurmJobsNamed("rcfd-" + orphan.id), std::vector<std::string>{orphan.slurmJobId + " RUNNING"});
+  const auto server = expectFollowedToTheEnd(orphan);
   EXPECT_NE(server->stderrText().find("following 1 job(s) already in Slurm"), std::string::npos)
       << server->stderrText();
 }
@@ -394,27 +406,12 @@ TEST_F(SlurmExecutor, ServerKilledMidJobFollowsTheSameSlurmJobToTheEnd) {
 // here by clearing the stored id): the next server finds the Slurm job by its name (rcfd-ID-ATTEMPT),
 // stores its id and follows it; nothing is submitted again.
 TEST_F(SlurmExecutor, ServerKilledBeforeStoringTheSlurmIdFindsTheJobByItsName) {
-  std::string id, slurmJobId;
-  {
-    auto server = startSlurmServer();
-    id = submit(*server, sprayJob(upload(*server), 12.0, 7));
-    const pid_t solver = frozenSolverWithCheckpoint(id);
-    ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen; " << eventReasons(*server, id);
-    slurmJobId = storedSlurmJobId(dataDir(), id);
-    server->stop(SIGKILL);
-    ::kill(solver, SIGCONT);
-  }
-  ASSERT_FALSE(slurmJobId.empty());
+  const OrphanedJob orphan = killServerMidJob(7);
+  ASSERT_FALSE(orphan.slurmJobId.empty());
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open((dataDir() / "rcfd.sqlite").c_str(), &db), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db, "UPDATE jobs SET slurm_job_id = NULL", nullptr, nullptr, nullptr), SQLITE_OK);
   sqlite3_close(db);
-  ASSERT_EQ(storedSlurmJobId(dataDir(), id), "");
-
-  auto server = startSlurmServer();
-  const auto done = pollJob(*server, id, isFinal);
-  EXPECT_EQ(done.at("state"), "SUCCEEDED") << done.dump(2) << eventReasons(*server, id);
-  EXPECT_EQ(done.at("attempt"), 1);
-  EXPECT_EQ(storedSlurmJobId(dataDir(), id), slurmJobId);
-  EXPECT_EQ(slurmJobsNamed("rcfd-" + id), std::vector<std::string>{slurmJobId + " COMPLETED"});
+  ASSERT_EQ(storedSlurmJobId(dataDir(), orphan.id), "");
+  expectFollowedToTheEnd(orphan);
 }
