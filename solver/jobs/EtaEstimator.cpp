@@ -15,6 +15,13 @@ void EtaEstimator::restart(double t, double fraction) {
   raw_ = -1.0;
 }
 
+void EtaEstimator::skip(double seconds) {
+  if (!(seconds > 0.0)) return;
+  for (auto& sample : samples_) sample.first += seconds;
+  start_ += seconds;
+  lastTime_ += seconds;
+}
+
 double EtaEstimator::update(double t, double fraction) {
   if (fraction < samples_.back().second) restart(t, fraction);
   if (fraction >= 1.0) {

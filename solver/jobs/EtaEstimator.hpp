@@ -55,6 +55,11 @@ class EtaEstimator {
   /// fraction reaches 1.
   double update(double t, double fraction);
 
+  /// Forgets `seconds` of wall time before the next update, as if they had not passed: the process was
+  /// stopped (SIGSTOP, a suspended Slurm job) and neither ran nor could report. Without this, the first
+  /// update after a long stop reads the stop as a stall and the estimate needs minutes to come back.
+  void skip(double seconds);
+
   /// The unlimited estimate of the last update (-1: none).
   double raw() const { return raw_; }
 

@@ -1,14 +1,41 @@
 #include "jobs/Progress.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <mutex>
 #include <nlohmann/json.hpp>
 
 namespace rcfd {
+namespace {
+
+std::atomic<std::uint64_t> continuations{0};
+
+void onContinue(int) { continuations.fetch_add(1, std::memory_order_relaxed); }
+
+/// Counts SIGCONT from now on; SA_RESTART, so no system call of the job sees EINTR for it.
+void countContinuations() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    struct sigaction action {};
+    action.sa_handler = onContinue;
+    action.sa_flags = SA_RESTART;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGCONT, &action, nullptr);
+  });
+}
+
+}  // namespace
+
+std::uint64_t processContinuations() { return continuations.load(std::memory_order_relaxed); }
 
 ProgressReporter::ProgressReporter(bool json, double intervalSeconds, std::string label)
-    : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {}
+    : json_(json), interval_(intervalSeconds), label_(std::move(label)), start_(std::chrono::steady_clock::now()) {
+  countContinuations();
+  seenContinuations_ = processContinuations();
+}
 
 double ProgressReporter::wallTime() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -37,7 +64,14 @@ void ProgressReporter::report(double fraction, double simTime, bool force) {
   lastReport_ = now;
   phaseReported_ = true;
   fraction = std::clamp(fraction, 0.0, 1.0);
+  // A stop since the last update (SIGSTOP ... SIGCONT) is time the job did not run: left out of the
+  // rate, so the estimate goes on from where it stood (the wall time still counts it).
+  if (const std::uint64_t c = processContinuations(); c != seenContinuations_) {
+    seenContinuations_ = c;
+    eta_.skip(now - lastEtaUpdate_ - interval_);  // the reporting interval of it ran
+  }
   const double eta = eta_.update(now, fraction);
+  lastEtaUpdate_ = now;
   const double wall = prior_ + now;
   const bool phaseKnown = !phase_.empty() && phaseFraction_ >= 0.0;
   const double phaseFraction = std::min(1.0, phaseFraction_);

@@ -12,11 +12,16 @@
 /// its weight in the whole is small.
 
 #include <chrono>
+#include <cstdint>
 #include <string>
 
 #include "jobs/EtaEstimator.hpp"
 
 namespace rcfd {
+
+/// How often this process has been continued after a stop (SIGCONT), counted from the first
+/// ProgressReporter on: the reporter leaves a stopped stretch out of its ETA.
+std::uint64_t processContinuations();
 
 class ProgressReporter {
  public:
@@ -28,7 +33,10 @@ class ProgressReporter {
   /// Wall seconds already spent before a resume, counted into wall_time.
   void setPriorWallTime(double seconds) { prior_ = seconds; }
   /// Fraction already done when this process started (so the ETA uses this process's rate only).
-  void setStartFraction(double fraction) { eta_.restart(wallTime(), fraction); }
+  void setStartFraction(double fraction) {
+    lastEtaUpdate_ = wallTime();
+    eta_.restart(lastEtaUpdate_, fraction);
+  }
   /// Names the phase the job is in ("fill", "sample", "recurrence", ...): the "phase" of every later
   /// report. A new phase is reported at the next report() whatever the interval, so a reader sees it
   /// as soon as it starts. Clears the phase fraction.
@@ -49,6 +57,8 @@ class ProgressReporter {
   std::chrono::steady_clock::time_point start_;
   double lastReport_ = -1e300;
   EtaEstimator eta_;
+  double lastEtaUpdate_ = 0.0;           ///< wall time of the estimator's last update [s]
+  std::uint64_t seenContinuations_ = 0;  ///< processContinuations() at that update
 };
 
 /// A duration as people read it: "45 s", "12 min 05 s", "3 h 07 min"; "?" when negative or not finite.

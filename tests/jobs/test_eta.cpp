@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <vector>
 
 #include "jobs/EtaEstimator.hpp"
@@ -141,6 +142,31 @@ TEST(EtaEstimator, AStallRaisesTheEstimateGraduallyAndItRecoversAfterwards) {
   EXPECT_GT(reports[2999].eta, 2.0 * before.eta);
   // Back at the old rate: the truth again within minutes.
   expectTrueFrom(reports, 3000.0 + 600.0, 1e-6);
+}
+
+TEST(EtaEstimator, AStoppedProcessGoesOnFromItsEstimateWhenContinued) {
+  // 1 % per minute to 40 %; then the process is stopped for 25 min (no update at all) and goes on at
+  // the same rate. Told of the stop, the estimate goes on from 60 min; not told, the first update
+  // reads the stop as a stall and the estimate climbs far beyond the truth.
+  auto run = [](bool told) {
+    EtaEstimator eta;
+    play(eta, {{2400.0, 0.4}});
+    if (told) eta.skip(1500.0);
+    std::vector<double> after;
+    for (int k = 1; k <= 120; ++k) after.push_back(eta.update(2400.0 + 1500.0 + k, 0.4 + 0.01 * k / 60.0));
+    return after;
+  };
+  const auto told = run(true), untold = run(false);
+  for (int k = 1; k <= 120; ++k) EXPECT_NEAR(told[std::size_t(k - 1)], 3600.0 - k, 1e-6) << k;
+  EXPECT_GT(untold.front(), 10.0 * 3600.0);
+  EXPECT_GT(untold.back(), 2.0 * 3600.0);
+}
+
+TEST(Progress, ASigcontIsCounted) {
+  ProgressReporter reporter(false, 1.0);  // counts SIGCONT from here on
+  const std::uint64_t before = processContinuations();
+  ASSERT_EQ(std::raise(SIGCONT), 0);
+  EXPECT_EQ(processContinuations(), before + 1);
 }
 
 TEST(EtaEstimator, ARestartFromACheckpointUsesOnlyTheNewProcesssRate) {
