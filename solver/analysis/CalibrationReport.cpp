@@ -165,6 +165,10 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
       s.staysJson = c.toJson();
     }
     if (refHoldup && refHoldupMean > 0.0) s.holdupRelativeError = (s.holdupMean - refHoldupMean) / refHoldupMean;
+    if (in.reference.sampledPeriod && s.stays > 0) {
+      s.sampledPeriodJson = compareWithPeriod(*in.reference.sampledPeriod, d.durationCounts, dt,
+                                              double(in.scene.rcfd.tracers), tracerPeriod, s.holdupMean, refMembers);
+    }
 
     // Mid-plane of the time averages, and their open-volume-weighted RMS difference there.
     d.midplane = slice(r.readFloats("/field_average/alpha_p_tracers"), grid, layer);
@@ -306,6 +310,7 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
                     {"counting_floor_rms", s.countingFloorRms},
                     {"rms_over_floor", s.rmsOverFloor()},
                     {"stay_comparison", s.staysJson},
+                    {"against_sampled_period", s.sampledPeriodJson},
                     {"field_rms_difference", s.fieldRms},
                     {"field_rms_difference_midplane", s.fieldRmsMidplane},
                     {"bed_shape_agrees", bool(sel.bedShapeAgrees[i])},
@@ -334,6 +339,17 @@ nlohmann::json writeCalibrationReport(const CalibrationInputs& in, const std::st
         summariseStays(onStepLattice(in.reference.durations, dt), refMembers, in.reference.recordedPeriod()).mean_s;
   }
   if (refHoldup) reference["holdup_mean"] = refHoldupMean;
+  if (const auto& sampled = in.reference.sampledPeriod) {
+    // The full simulation against itself: its sampled period (the frames') against the reference period.
+    const double sampledHoldup = sampled->holdupMean();
+    reference["sampled_period"] = {
+        {"period_s", sampled->recordedPeriod()},
+        {"holdup_mean", sampled->hasHoldup() ? nlohmann::json(sampledHoldup) : nlohmann::json()},
+        {"holdup_over_reference",
+         refHoldup && refHoldupMean > 0.0 && sampled->hasHoldup() ? nlohmann::json(sampledHoldup / refHoldupMean)
+                                                                  : nlohmann::json()},
+        {"stays", sampled->durations.size()}};
+  }
   // What the recurrence field itself holds in the zone over the runs' collected steps (one path for all
   // runs: the same average), beside the parcel centres the reference counts (docs/calibration.md).
   {

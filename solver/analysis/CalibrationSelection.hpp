@@ -30,6 +30,7 @@ struct D0Scores {
   std::optional<double> rtdMeanRelativeError;      ///< mean stay against the reference's on the lattice
   std::optional<double> crossingRateRelativeError; ///< stays per member per second against the reference's
   nlohmann::json staysJson;        ///< the StayComparison (null without a reference)
+  nlohmann::json sampledPeriodJson;  ///< against the full simulation's sampled period (null without it)
   double rmsOverFloor() const { return countingFloorRms > 0.0 ? instantaneousRms / countingFloorRms : 0.0; }
 };
 

@@ -9,6 +9,7 @@
 
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
+#include "analysis/StayComparison.hpp"
 
 namespace rcfd::analysis {
 namespace {
@@ -59,6 +60,43 @@ bool sameZone(const SprayZoneSpec& a, const SprayZoneSpec& b) {
          a.line_of_sight == b.line_of_sight;
 }
 
+/// Reads one period's stays and holdup into r (absent datasets into r.missing).
+void readPeriod(const h5::File& f, const std::string& path, const char* durations, const char* holdup,
+                ReferenceStatistics& r) {
+  namespace L = reference_layout;
+  if (f.exists(durations)) {
+    r.durations = readNonNegative(f, path, durations);
+    // Optional attributes: absent ones stay 0 (unknown); present ones must be finite and > 0.
+    auto optionalAttribute = [&](const char* name) {
+      if (!f.hasAttribute(durations, name)) return 0.0;
+      const double v = f.doubleAttribute(durations, name);
+      if (!std::isfinite(v) || !(v > 0.0)) {
+        throw InputError(path, std::string(durations) + "@" + name, std::to_string(v) + "; must be > 0");
+      }
+      return v;
+    };
+    r.durationsDt = optionalAttribute("dt");
+    r.members = optionalAttribute(L::members);
+    r.period = optionalAttribute(L::period);
+  } else {
+    r.missing.push_back(durations);
+  }
+  if (f.exists(holdup)) {
+    r.holdup = readNonNegative(f, path, holdup);
+    const std::string where = std::string(holdup) + "@" + L::holdupDt;
+    try {
+      r.holdupDt = f.doubleAttribute(holdup, L::holdupDt);
+    } catch (const RunError&) {
+      throw InputError(path, where, "attribute missing: the sampling interval of the holdup series [s]");
+    }
+    if (!std::isfinite(r.holdupDt) || !(r.holdupDt > 0.0)) {
+      throw InputError(path, where, std::to_string(r.holdupDt) + " s; must be > 0");
+    }
+  } else {
+    r.missing.push_back(holdup);
+  }
+}
+
 }  // namespace
 
 double ReferenceStatistics::holdupMean() const {
@@ -74,6 +112,31 @@ double referenceMembers(const ReferenceStatistics& reference, double bedMass, do
   return bedMass / particleMass;
 }
 
+nlohmann::json compareWithPeriod(const ReferenceStatistics& period, const std::vector<std::int64_t>& stepCounts,
+                                 double dt, double tracers, double runPeriod, double runHoldupMean,
+                                 double fallbackMembers) {
+  auto numberOrNull = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json out = {{"period_s", period.recordedPeriod()},
+                        {"holdup_mean", nullptr},
+                        {"holdup_relative_error", nullptr},
+                        {"ks_distance", nullptr},
+                        {"mean_relative_error", nullptr},
+                        {"crossing_rate_relative_error", nullptr}};
+  if (period.hasHoldup() && period.holdupMean() > 0.0) {
+    out["holdup_mean"] = period.holdupMean();
+    out["holdup_relative_error"] = (runHoldupMean - period.holdupMean()) / period.holdupMean();
+  }
+  if (period.hasDurations()) {
+    const double members = period.members > 0.0 ? period.members : fallbackMembers;
+    const StayComparison c =
+        compareStays(stepCounts, dt, tracers, runPeriod, period.durations, members, period.recordedPeriod());
+    out["ks_distance"] = c.ksDistance;
+    out["mean_relative_error"] = numberOrNull(c.meanError());
+    out["crossing_rate_relative_error"] = numberOrNull(c.crossingRateError());
+  }
+  return out;
+}
+
 ReferenceStatistics readReferenceStatistics(const std::string& path, const SprayZoneSpec* zone) {
   namespace L = reference_layout;
   ReferenceStatistics r;
@@ -86,36 +149,11 @@ ReferenceStatistics readReferenceStatistics(const std::string& path, const Spray
       return r;
     }
   }
-  if (f.exists(L::durations)) {
-    r.durations = readNonNegative(f, path, L::durations);
-    // Optional attributes: absent ones stay 0 (unknown); present ones must be finite and > 0.
-    auto optionalAttribute = [&](const char* name) {
-      if (!f.hasAttribute(L::durations, name)) return 0.0;
-      const double v = f.doubleAttribute(L::durations, name);
-      if (!std::isfinite(v) || !(v > 0.0)) {
-        throw InputError(path, std::string(L::durations) + "@" + name, std::to_string(v) + "; must be > 0");
-      }
-      return v;
-    };
-    r.durationsDt = optionalAttribute("dt");
-    r.members = optionalAttribute(L::members);
-    r.period = optionalAttribute(L::period);
-  } else {
-    r.missing.push_back(L::durations);
-  }
-  if (f.exists(L::holdup)) {
-    r.holdup = readNonNegative(f, path, L::holdup);
-    const std::string where = std::string(L::holdup) + "@" + L::holdupDt;
-    try {
-      r.holdupDt = f.doubleAttribute(L::holdup, L::holdupDt);
-    } catch (const RunError&) {
-      throw InputError(path, where, "attribute missing: the sampling interval of the holdup series [s]");
-    }
-    if (!std::isfinite(r.holdupDt) || !(r.holdupDt > 0.0)) {
-      throw InputError(path, where, std::to_string(r.holdupDt) + " s; must be > 0");
-    }
-  } else {
-    r.missing.push_back(L::holdup);
+  readPeriod(f, path, L::durations, L::holdup, r);
+  if (f.exists(L::sampledHoldup)) {
+    auto sampled = std::make_shared<ReferenceStatistics>();
+    readPeriod(f, path, L::sampledDurations, L::sampledHoldup, *sampled);
+    r.sampledPeriod = std::move(sampled);
   }
   return r;
 }

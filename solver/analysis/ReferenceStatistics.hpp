@@ -4,6 +4,9 @@
 /// database file (layout in docs/calibration.md). Optional: an imported database has none, and the
 /// calibration then reports which scores it could not compute.
 
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -29,6 +32,9 @@ inline constexpr const char* coverageDuration = "duration_s";                  /
 inline constexpr const char* coverageDt = "dt";                                ///< its step [s]
 inline constexpr const char* coverageParticlesPerParcel = "particles_per_parcel";  ///< cg^3 [-]
 inline constexpr const char* coverageSingleDroplet = "f";  ///< Eq. (15)'s f of the scene [-]
+/// Optional: the same stays and holdup over the sampled period (the frames'), in the same layout.
+inline constexpr const char* sampledDurations = "/reference/sampled_period/residence_time/durations_s";
+inline constexpr const char* sampledHoldup = "/reference/sampled_period/holdup/particles";
 }  // namespace reference_layout
 
 struct ReferenceStatistics {
@@ -42,6 +48,10 @@ struct ReferenceStatistics {
   /// Why the stays and the holdup were left out though present: the database's scene counted them in
   /// another spray zone than the job's (empty when they were kept).
   std::string zoneMismatch;
+  /// The full simulation's stays and holdup over the sampled period, the one the frames come from (null
+  /// when the database has none): the tracers can at best move like the particles of that period, and
+  /// the two periods' difference is the full simulation's own.
+  std::shared_ptr<const ReferenceStatistics> sampledPeriod;
 
   bool hasDurations() const { return !durations.empty(); }
   bool hasHoldup() const { return !holdup.empty(); }
@@ -54,6 +64,14 @@ struct ReferenceStatistics {
 /// scene's bed (bed mass over the mass of one particle), as the tracers' holdup is counted.
 double referenceMembers(const ReferenceStatistics& reference, double bedMass, double particleDensity,
                         double particleDiameter);
+
+/// A run's stays (counts per whole step of dt, over `tracers` members for `runPeriod` s) and mean holdup
+/// [particles] against one period of the full simulation: {"period_s", "holdup_mean",
+/// "holdup_relative_error", "ks_distance", "mean_relative_error", "crossing_rate_relative_error"} (nulls
+/// where the period lacks the dataset). `fallbackMembers`: the members when the period does not say.
+nlohmann::json compareWithPeriod(const ReferenceStatistics& period, const std::vector<std::int64_t>& stepCounts,
+                                 double dt, double tracers, double runPeriod, double runHoldupMean,
+                                 double fallbackMembers);
 
 /// Reads the reference statistics of a database file. Absent datasets go into `missing`; present but
 /// malformed ones (non-finite or negative values, empty, missing or non-positive dt) are an

@@ -4,6 +4,7 @@
 
 #include "analysis/ReferenceStatistics.hpp"
 #include "analysis/SeriesSpectrum.hpp"
+#include "analysis/StayComparison.hpp"
 #include "core/Errors.hpp"
 #include "geometry/Apparatus.hpp"
 #include "core/Hdf5.hpp"
@@ -23,7 +24,8 @@ ReferenceRecorder::ReferenceRecorder(const Scene& scene, const CartesianGrid& gr
       dt_(dt),
       referenceStart_(referenceStart),
       particlesPerParcel_(std::pow(scene.dem.coarse_graining, 3)),
-      stays_(parcels) {
+      stays_(parcels),
+      sampledStays_(parcels) {
   for (const auto& p : scene.probes) probeCells_.push_back(grid.flatIndexOf(p.position));
 }
 
@@ -32,25 +34,33 @@ void ReferenceRecorder::record(const std::vector<Eigen::Vector3d>& particleVeloc
   const std::int64_t s = samples();
   for (const std::int64_t c : probeCells_) probeVelocity_.push_back(particleVelocity.at(std::size_t(c)).y());
   pressureDrop_.push_back(pressureDrop);
-  if (s < referenceStart_) return;
+  if (s < referenceStart_) {
+    observeZone(parcels, s, 0, sampledStays_, sampledHoldup_);
+  } else {
+    observeZone(parcels, s, referenceStart_, stays_, holdup_);
+  }
+}
+
+void ReferenceRecorder::observeZone(const DemParticles& parcels, std::int64_t s, std::int64_t countFrom,
+                                    ZoneStays& stays, std::vector<std::int64_t>& holdup) {
   std::int64_t inside = 0;
   std::vector<std::int64_t> finished;
   for (std::size_t i = 0; i < parcels.size(); ++i) {
     const std::uint64_t id = parcels.id[i];
-    if (id >= stays_.members()) {
+    if (id >= stays.members()) {
       throw RunError("reference statistics: parcel id " + std::to_string(id) + " beyond the " +
-                     std::to_string(stays_.members()) + " parcels of the bed");
+                     std::to_string(stays.members()) + " parcels of the bed");
     }
     const bool in = zone_.contains(parcels.x[i]);
     inside += in;
-    if (s == referenceStart_) {
-      if (in) stays_.startInside(std::size_t(id));  // entered before the reference period: not counted
-    } else if (const std::int64_t d = stays_.observe(std::size_t(id), in, s, referenceStart_); d >= 0) {
+    if (s == countFrom) {
+      if (in) stays.startInside(std::size_t(id));  // entered before the period: not counted
+    } else if (const std::int64_t d = stays.observe(std::size_t(id), in, s, countFrom); d >= 0) {
       finished.push_back(d);
     }
   }
-  stays_.addDurations(finished);
-  holdup_.push_back(inside);
+  stays.addDurations(finished);
+  holdup.push_back(inside);
 }
 
 std::vector<double> ReferenceRecorder::probeSeries(std::size_t p, std::int64_t first, std::int64_t last) const {
@@ -67,6 +77,8 @@ void ReferenceRecorder::save(h5::File& f, const std::string& g) const {
   f.write(g + "/pressure_drop", pressureDrop_);
   f.write(g + "/holdup", holdup_);
   stays_.save(f, g + "/stays");
+  f.write(g + "/sampled_holdup", sampledHoldup_);
+  sampledStays_.save(f, g + "/sampled_stays");
 }
 
 void ReferenceRecorder::load(const h5::File& f, const std::string& g) {
@@ -74,6 +86,14 @@ void ReferenceRecorder::load(const h5::File& f, const std::string& g) {
   pressureDrop_ = f.readDoubles(g + "/pressure_drop");
   holdup_ = f.readInt64s(g + "/holdup");
   stays_.load(f, g + "/stays");
+  // A checkpoint written before the sampled period was recorded resumes without it.
+  sampledRecorded_ = f.exists(g + "/sampled_holdup");
+  if (sampledRecorded_) {
+    sampledHoldup_ = f.readInt64s(g + "/sampled_holdup");
+    sampledStays_.load(f, g + "/sampled_stays");
+  } else {
+    sampledHoldup_.clear();
+  }
   if (probeVelocity_.size() != pressureDrop_.size() * probeCells_.size()) {
     throw InputError(f.path(), g + "/probe_velocity", "does not match the scene's probes");
   }
@@ -106,6 +126,20 @@ void ReferenceRecorder::write(h5::File& db) const {
     db.setAttribute(R::holdupParcels, "dt", dt_);
     db.setAttribute(R::holdupParcels, "t0", t0);
   }
+  if (sampledPeriodRecorded()) {
+    const std::vector<double> sampled = sampledStays_.durations(dt_);
+    if (!sampled.empty()) {
+      db.write(L::sampledDurations, sampled);
+      db.setAttribute(L::sampledDurations, "dt", dt_);
+      db.setAttribute(L::sampledDurations, L::members, double(sampledStays_.members()));
+      db.setAttribute(L::sampledDurations, L::period, double(sampledHoldup_.size()) * dt_);
+    }
+    std::vector<double> particles(sampledHoldup_.size());
+    for (std::size_t s = 0; s < sampledHoldup_.size(); ++s) particles[s] = double(sampledHoldup_[s]) * particlesPerParcel_;
+    db.write(L::sampledHoldup, particles);
+    db.setAttribute(L::sampledHoldup, L::holdupDt, dt_);
+    db.setAttribute(L::sampledHoldup, "t0", 0.0);
+  }
   if (!pressureDrop_.empty()) {
     db.write(R::pressureDrop, pressureDrop_);
     db.setAttribute(R::pressureDrop, "dt", dt_);
@@ -127,6 +161,41 @@ void ReferenceRecorder::write(h5::File& db) const {
   db.createGroup("/reference");
   db.setAttribute("/reference", "dt", dt_);
   db.setAttribute("/reference", "reference_t0", t0);
+}
+
+nlohmann::json ReferenceRecorder::periodsSummary() const {
+  if (!sampledPeriodRecorded() || holdup_.empty()) return nullptr;
+  auto mean = [](const std::vector<std::int64_t>& v) {
+    double sum = 0.0;
+    for (const auto h : v) sum += double(h);
+    return sum / double(v.size());
+  };
+  const double sampledHoldup = mean(sampledHoldup_) * particlesPerParcel_;
+  const double referenceHoldup = mean(holdup_) * particlesPerParcel_;
+  const double members = double(stays_.members());
+  const auto c = analysis::compareStays(sampledStays_.durationCounts(), dt_, members,
+                                        double(sampledHoldup_.size()) * dt_, stays_.durations(dt_), members,
+                                        double(holdup_.size()) * dt_);
+  // The comparison's "tracers" side is the sampled period here.
+  nlohmann::json stays = c.toJson();
+  stays["resolution"] = "both periods on the recorder's lattice";
+  stays["sampled_period"] = stays["tracers"];
+  stays["reference_period"] = stays["reference"];
+  stays.erase("tracers");
+  stays.erase("reference");
+  stays["window"]["sampled_period_s"] = stays["window"]["tracers_s"];
+  stays["window"]["sampled_period_beyond_fraction"] = stays["window"]["tracers_beyond_fraction"];
+  stays["window"].erase("tracers_s");
+  stays["window"].erase("tracers_beyond_fraction");
+  return {{"what", "the full simulation's sampled period (the frames') against its reference period: how far "
+                   "two of its periods differ"},
+          {"sampled_period_holdup_mean", sampledHoldup},
+          {"reference_period_holdup_mean", referenceHoldup},
+          {"holdup_relative_difference", numberOrNull((sampledHoldup - referenceHoldup) / referenceHoldup)},
+          {"stays", stays},
+          {"sampled_period_files",
+           {std::string("database.h5:") + analysis::reference_layout::sampledDurations,
+            std::string("database.h5:") + analysis::reference_layout::sampledHoldup}}};
 }
 
 nlohmann::json ReferenceRecorder::summary(double dtRec, int residenceTimeBins) const {
@@ -159,6 +228,7 @@ nlohmann::json ReferenceRecorder::summary(double dtRec, int residenceTimeBins) c
     dp["dominant_frequency_hz"] = nullptr;
   }
   out["pressure_drop"] = dp;
+  out["periods"] = periodsSummary();
 
   // Eq. (8) from each probe's u_P,y over the sampled period, sampled every dt_ < dt_rec.
   nlohmann::json probes = nlohmann::json::array();

@@ -6,7 +6,10 @@
 ///    Eq. (8) criterion from a signal sampled faster than dt_rec) and the bed pressure drop;
 ///  - from sample `referenceStart` on: the spray-zone holdup (parcels inside, reported in real
 ///    particles, cg^3 per parcel, as the calibration compares them) and every completed stay of a
-///    parcel (by its permanent id) in the spray zone.
+///    parcel (by its permanent id) in the spray zone;
+///  - before it, the same holdup and stays over the sampled period, the one the frames come from: the
+///    full simulation against itself (one period against the next) says how far two of its periods
+///    differ, the least any comparison of tracers with one of them can be trusted to.
 /// Stored under /reference/ in the database file (docs/formats.md, docs/calibration.md).
 
 #include <Eigen/Core>
@@ -56,6 +59,13 @@ class ReferenceRecorder {
   const ZoneStays& stays() const { return stays_; }
   /// Holdup series of the reference period [parcels].
   const std::vector<std::int64_t>& holdupParcels() const { return holdup_; }
+  /// The same over the sampled period, and its stays; complete only when `sampledPeriodRecorded()`
+  /// (a job resumed from a checkpoint that did not keep them has none).
+  const std::vector<std::int64_t>& sampledHoldupParcels() const { return sampledHoldup_; }
+  const ZoneStays& sampledStays() const { return sampledStays_; }
+  bool sampledPeriodRecorded() const {
+    return sampledRecorded_ && referenceStart_ > 0 && sampledHoldup_.size() == std::size_t(referenceStart_);
+  }
   double particlesPerParcel() const { return particlesPerParcel_; }
 
   /// Checkpoint state.
@@ -66,8 +76,9 @@ class ReferenceRecorder {
   /// in particles in the layout of analysis/ReferenceStatistics.hpp, plus probes and pressure drop.
   void write(h5::File& database) const;
 
-  /// summary.json parts: "residence_time", "holdup", "pressure_drop" and "sampling_criterion" (Eq. (8)
-  /// of each probe's u_P,y over the sampled period, against dtRec).
+  /// summary.json parts: "residence_time", "holdup", "pressure_drop", "sampling_criterion" (Eq. (8)
+  /// of each probe's u_P,y over the sampled period, against dtRec) and "periods" (the sampled period's
+  /// holdup and stays against the reference period's, null when not recorded).
   nlohmann::json summary(double dtRec, int residenceTimeBins) const;
 
  private:
@@ -81,6 +92,13 @@ class ReferenceRecorder {
   std::vector<double> pressureDrop_;   ///< [S]
   std::vector<std::int64_t> holdup_;   ///< [R] parcels in the zone
   ZoneStays stays_;                    ///< by parcel id, in samples
+  std::vector<std::int64_t> sampledHoldup_;  ///< the sampled period's, [referenceStart]
+  ZoneStays sampledStays_;
+  bool sampledRecorded_ = true;
+  nlohmann::json periodsSummary() const;
+  /// Counts the parcels in the zone at sample s into `holdup` and `stays` (stays from `countFrom`).
+  void observeZone(const DemParticles& parcels, std::int64_t s, std::int64_t countFrom, ZoneStays& stays,
+                   std::vector<std::int64_t>& holdup);
 };
 
 }  // namespace rcfd

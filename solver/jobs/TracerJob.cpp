@@ -41,7 +41,7 @@ namespace {
 /// The run's spray-zone stays against the full simulation's reference in the database, on the tracers'
 /// step lattice (analysis/StayComparison.hpp); null without residence_time or without a reference.
 nlohmann::json stayComparison(const JobSpec& job, const Scene& scene, const std::string& resultPath,
-                              std::int64_t steps) {
+                              std::int64_t steps, double holdupMean) {
   analysis::ReferenceStatistics reference;
   try {
     reference = analysis::readReferenceStatistics(job.database, &scene.spray.spray_zone);
@@ -58,10 +58,17 @@ nlohmann::json stayComparison(const JobSpec& job, const Scene& scene, const std:
   if (!reference.hasDurations() || !result.exists(counts)) return nullptr;
   const double members = analysis::referenceMembers(reference, scene.process.bed_mass, scene.particles.density,
                                                     scene.particles.diameter);
-  return analysis::compareStays(result.readInt64s(counts), scene.rcfd.dt, double(scene.rcfd.tracers),
-                                double(steps) * scene.rcfd.dt, reference.durations, members,
-                                reference.recordedPeriod())
-      .toJson();
+  const std::vector<std::int64_t> stepCounts = result.readInt64s(counts);
+  nlohmann::json out = analysis::compareStays(stepCounts, scene.rcfd.dt, double(scene.rcfd.tracers),
+                                              double(steps) * scene.rcfd.dt, reference.durations, members,
+                                              reference.recordedPeriod())
+                           .toJson();
+  if (reference.sampledPeriod) {
+    out["against_sampled_period"] =
+        analysis::compareWithPeriod(*reference.sampledPeriod, stepCounts, scene.rcfd.dt, double(scene.rcfd.tracers),
+                                    double(steps) * scene.rcfd.dt, holdupMean, members);
+  }
+  return out;
 }
 
 /// Opens the recurrence set-up's phase of a run that has `priorWall` seconds and `startFraction` of its
@@ -120,7 +127,8 @@ nlohmann::json writeRunResults(const JobSpec& job, const TracerSimulation& sim, 
   std::filesystem::rename(dir + "/result.h5.tmp", dir + "/result.h5");
   xdmf::writeSidecar(dir + "/result.h5", xdmfGrid(sim.context().grid));
   poll();
-  summary["stay_comparison"] = stayComparison(job, scene, dir + "/result.h5", steps);
+  summary["stay_comparison"] =
+      stayComparison(job, scene, dir + "/result.h5", steps, summary.value(nlohmann::json::json_pointer("/holdup/mean"), 0.0));
   summary["coverage_comparison"] =
       coverageComparison(job, scene, dir + "/result.h5", sim.cloud().particlesPerTracer, sim.time());
   poll();

@@ -14,6 +14,7 @@
 
 #include "analysis/AlphaProfiles.hpp"
 #include "analysis/DatabaseFigures.hpp"
+#include "analysis/ReferenceStatistics.hpp"
 #include "analysis/SeriesSpectrum.hpp"
 #include "analysis/ZoneStays.hpp"
 #include "scene/DatabaseSchedule.hpp"
@@ -270,6 +271,76 @@ TEST(ReferenceRecorder, FreeFallThroughTheSprayZoneGivesTheKinematicStays) {
   EXPECT_EQ(sum["residence_time"]["censored"].get<int>(), 0);
   EXPECT_TRUE(sum["pressure_drop"]["dominant_frequency_hz"].is_null());
   EXPECT_DOUBLE_EQ(sum["pressure_drop"]["mean_pa"].get<double>(), 0.0);
+}
+
+// The sampled period (the frames') is counted as the reference period is: one fall recorded by a
+// recorder whose reference period starts at once and by one whose sampled period holds the whole fall
+// gives the same stays and holdup; they survive a checkpoint, reach the database file in the reference
+// layout, and compared with themselves differ by nothing.
+TEST(ReferenceRecorder, TheSampledPeriodIsCountedAsTheReferencePeriodIs) {
+  const rcfd::Scene scene = rcfd::loadScene(boxScene());
+  const rcfd::Apparatus box(scene.apparatus);
+  const rcfd::CartesianGrid grid = rcfd::makeGrid(box, scene.grid);
+  rcfd::DemSystem dem(rcfd::DemMaterial::fromScene(scene),
+                      rcfd::DemWalls::box(box.lowerCorner(), box.upperCorner()),
+                      rcfd::DemSystem::settingsFromScene(scene));
+  const std::vector<double> xs = {-0.02, -0.005, 0.0, 0.01, 0.035, 0.045};
+  for (const double x : xs) dem.addParticle(Eigen::Vector3d(x, 0.25, 0.02));
+  const auto p = rcfd::DatabaseSchedule::fromScene(scene);
+  const std::int64_t samples = 210;
+  rcfd::ReferenceRecorder reference(scene, grid, xs.size(), p.sampleDt(), 0);
+  rcfd::ReferenceRecorder sampled(scene, grid, xs.size(), p.sampleDt(), samples);
+  const std::vector<Eigen::Vector3d> noVelocity(std::size_t(grid.cellCount()), Eigen::Vector3d::Zero());
+  const std::string path = (fs::temp_directory_path() / ("sampled-period-" + std::to_string(::getpid()) + ".h5")).string();
+  for (std::int64_t s = 0; s <= samples; ++s) {
+    reference.record(noVelocity, 0.0, dem.particles());
+    sampled.record(noVelocity, 0.0, dem.particles());
+    if (s == samples / 2) {  // a checkpoint halfway through the sampled period
+      {
+        rcfd::h5::File f(path, rcfd::h5::File::Mode::Create);
+        sampled.save(f, "/reference");
+      }
+      rcfd::ReferenceRecorder resumed(scene, grid, xs.size(), p.sampleDt(), samples);
+      resumed.load(rcfd::h5::File(path, rcfd::h5::File::Mode::ReadOnly), "/reference");
+      EXPECT_EQ(resumed.sampledHoldupParcels(), sampled.sampledHoldupParcels());
+      EXPECT_EQ(resumed.sampledStays().open(), sampled.sampledStays().open());
+    }
+    dem.run(p.sampleSteps);
+  }
+  ASSERT_TRUE(sampled.sampledPeriodRecorded());
+  EXPECT_FALSE(reference.sampledPeriodRecorded());  // no sampled period
+  const auto expectedStays = reference.stays().durations(p.sampleDt());
+  ASSERT_EQ(expectedStays.size(), xs.size());  // every parcel falls through the zone
+  EXPECT_EQ(sampled.sampledStays().durations(p.sampleDt()), expectedStays);
+  EXPECT_EQ(sampled.sampledHoldupParcels(),
+            std::vector<std::int64_t>(reference.holdupParcels().begin(), reference.holdupParcels().end() - 1));
+  EXPECT_TRUE(sampled.stays().durations(p.sampleDt()).empty());
+  {
+    rcfd::h5::File db(path, rcfd::h5::File::Mode::Create);
+    sampled.write(db);
+  }
+  const auto read = rcfd::analysis::readReferenceStatistics(path);
+  ASSERT_TRUE(read.sampledPeriod);
+  EXPECT_EQ(read.sampledPeriod->durations, expectedStays);
+  EXPECT_DOUBLE_EQ(read.sampledPeriod->members, double(xs.size()));
+  EXPECT_NEAR(read.sampledPeriod->recordedPeriod(), double(samples) * p.sampleDt(), 1e-12);
+  ASSERT_EQ(read.sampledPeriod->holdup.size(), std::size_t(samples));
+  // The same stays seen as a run's step counts on the recorder's lattice: no difference at all.
+  double holdupMean = 0.0;
+  for (const auto h : sampled.sampledHoldupParcels()) holdupMean += double(h) / double(samples);
+  const json c = rcfd::analysis::compareWithPeriod(*read.sampledPeriod, reference.stays().durationCounts(), p.sampleDt(),
+                                                   double(xs.size()), double(samples) * p.sampleDt(), holdupMean, 0.0);
+  EXPECT_NEAR(c["holdup_relative_error"].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(c["ks_distance"].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(c["mean_relative_error"].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(c["crossing_rate_relative_error"].get<double>(), 0.0, 1e-12);
+  // The summary compares the two periods (the reference period: one sample, every parcel below the zone).
+  const json periods = sampled.summary(p.dtRec(), 10)["periods"];
+  ASSERT_TRUE(periods.is_object());
+  EXPECT_NEAR(periods["sampled_period_holdup_mean"].get<double>(), holdupMean * sampled.particlesPerParcel(), 1e-9);
+  EXPECT_DOUBLE_EQ(periods["reference_period_holdup_mean"].get<double>(), 0.0);
+  EXPECT_TRUE(periods["holdup_relative_difference"].is_null());
+  fs::remove(path);
 }
 
 TEST(DatabaseFigures, SnapshotsTimeAverageAndPressureDrop) {
