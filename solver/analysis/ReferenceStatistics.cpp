@@ -117,9 +117,7 @@ nlohmann::json compareWithPeriod(const ReferenceStatistics& period, const std::v
                                  double fallbackMembers) {
   auto numberOrNull = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json out = {{"period_s", period.recordedPeriod()},
-                        {"holdup_mean", nullptr},
                         {"holdup_relative_error", nullptr},
-                        {"ks_distance", nullptr},
                         {"mean_relative_error", nullptr},
                         {"crossing_rate_relative_error", nullptr}};
   if (period.hasHoldup() && period.holdupMean() > 0.0) {

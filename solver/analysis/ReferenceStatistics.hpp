@@ -66,9 +66,10 @@ double referenceMembers(const ReferenceStatistics& reference, double bedMass, do
                         double particleDiameter);
 
 /// A run's stays (counts per whole step of dt, over `tracers` members for `runPeriod` s) and mean holdup
-/// [particles] against one period of the full simulation: {"period_s", "holdup_mean",
-/// "holdup_relative_error", "ks_distance", "mean_relative_error", "crossing_rate_relative_error"} (nulls
-/// where the period lacks the dataset). `fallbackMembers`: the members when the period does not say.
+/// [particles] against one period of the full simulation: {"period_s", "holdup_relative_error",
+/// "mean_relative_error", "crossing_rate_relative_error"} (null where the period lacks the dataset) and,
+/// where it has them, "holdup_mean" and "ks_distance". `fallbackMembers`: the members when the period
+/// does not say.
 nlohmann::json compareWithPeriod(const ReferenceStatistics& period, const std::vector<std::int64_t>& stepCounts,
                                  double dt, double tracers, double runPeriod, double runHoldupMean,
                                  double fallbackMembers);

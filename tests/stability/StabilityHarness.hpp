@@ -96,7 +96,8 @@ inline void findNulls(const json& v, const std::string& at, std::vector<std::str
       "binding_d0", "selected_d0", "error", "crossings_per_member_per_s", "crossing_rate_relative_error",
       "mean_relative_error", "longest_compared_s", "rtd_ks_distance", "holdup_relative_error",
       "residence_time_mean_relative_error", "bound_s", "largest_admissible_dt_rec_s", "satisfied",
-      "mean_pa", "std_pa", "frequency_resolution_hz"};  // (a pressure-drop series of fewer than 4 samples)
+      "mean_pa", "std_pa", "frequency_resolution_hz",
+      "periods", "holdup_relative_difference", "against_sampled_period"};  // (no reference period, or none in it)  // (a pressure-drop series of fewer than 4 samples)
   if (v.is_null()) {
     const std::string key = at.substr(at.rfind('/') + 1);
     if (!nullable.count(key)) out.push_back("summary.json" + at + " is null (a NaN or infinity?)");
