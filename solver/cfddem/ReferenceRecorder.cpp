@@ -103,43 +103,33 @@ void ReferenceRecorder::write(h5::File& db) const {
   namespace L = analysis::reference_layout;
   namespace R = reference_series;
   const double t0 = double(referenceStart_) * dt_;
-  // The calibration refuses empty reference datasets: leave out what the run did not produce.
-  const std::vector<double> durations = stays_.durations(dt_);
-  if (!durations.empty()) {
-    db.write(L::durations, durations);
-    db.setAttribute(L::durations, "dt", dt_);
-    // What a crossing rate (stays per member per second) divides by.
-    db.setAttribute(L::durations, L::members, double(stays_.members()));
-    db.setAttribute(L::durations, L::period, double(holdup_.size()) * dt_);
-  }
-  if (!holdup_.empty()) {
-    std::vector<double> particles(holdup_.size()), parcels(holdup_.size());
-    for (std::size_t s = 0; s < holdup_.size(); ++s) {
-      parcels[s] = double(holdup_[s]);
-      particles[s] = parcels[s] * particlesPerParcel_;
+  // One period's stays and holdup [particles] in the layout of analysis/ReferenceStatistics.hpp. The
+  // calibration refuses empty reference datasets: leave out what the run did not produce.
+  auto writePeriod = [&](const char* durationsName, const char* holdupName, const ZoneStays& stays,
+                         const std::vector<std::int64_t>& holdup, double start) {
+    const std::vector<double> durations = stays.durations(dt_);
+    if (!durations.empty()) {
+      db.write(durationsName, durations);
+      db.setAttribute(durationsName, "dt", dt_);
+      // What a crossing rate (stays per member per second) divides by.
+      db.setAttribute(durationsName, L::members, double(stays.members()));
+      db.setAttribute(durationsName, L::period, double(holdup.size()) * dt_);
     }
-    db.write(L::holdup, particles);
-    db.setAttribute(L::holdup, L::holdupDt, dt_);
-    db.setAttribute(L::holdup, "t0", t0);
-    db.setAttribute(L::holdup, "particles_per_parcel", particlesPerParcel_);
-    db.write(R::holdupParcels, parcels);
+    if (holdup.empty()) return;
+    std::vector<double> particles(holdup.size());
+    for (std::size_t s = 0; s < holdup.size(); ++s) particles[s] = double(holdup[s]) * particlesPerParcel_;
+    db.write(holdupName, particles);
+    db.setAttribute(holdupName, L::holdupDt, dt_);
+    db.setAttribute(holdupName, "t0", start);
+    db.setAttribute(holdupName, "particles_per_parcel", particlesPerParcel_);
+  };
+  writePeriod(L::durations, L::holdup, stays_, holdup_, t0);
+  if (!holdup_.empty()) {
+    db.write(R::holdupParcels, std::vector<double>(holdup_.begin(), holdup_.end()));
     db.setAttribute(R::holdupParcels, "dt", dt_);
     db.setAttribute(R::holdupParcels, "t0", t0);
   }
-  if (sampledPeriodRecorded()) {
-    const std::vector<double> sampled = sampledStays_.durations(dt_);
-    if (!sampled.empty()) {
-      db.write(L::sampledDurations, sampled);
-      db.setAttribute(L::sampledDurations, "dt", dt_);
-      db.setAttribute(L::sampledDurations, L::members, double(sampledStays_.members()));
-      db.setAttribute(L::sampledDurations, L::period, double(sampledHoldup_.size()) * dt_);
-    }
-    std::vector<double> particles(sampledHoldup_.size());
-    for (std::size_t s = 0; s < sampledHoldup_.size(); ++s) particles[s] = double(sampledHoldup_[s]) * particlesPerParcel_;
-    db.write(L::sampledHoldup, particles);
-    db.setAttribute(L::sampledHoldup, L::holdupDt, dt_);
-    db.setAttribute(L::sampledHoldup, "t0", 0.0);
-  }
+  if (sampledPeriodRecorded()) writePeriod(L::sampledDurations, L::sampledHoldup, sampledStays_, sampledHoldup_, 0.0);
   if (!pressureDrop_.empty()) {
     db.write(R::pressureDrop, pressureDrop_);
     db.setAttribute(R::pressureDrop, "dt", dt_);

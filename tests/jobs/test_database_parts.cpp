@@ -225,19 +225,30 @@ TEST(ZoneStays, CountsCompletedStaysOnlyAndSurvivesACheckpoint) {
   fs::remove(path);
 }
 
+/// Parcels at rest at (x, 0.25 m, 0.02 m) for each x in the box scene, about to fall through its
+/// spray-zone cone (half-angle 30 deg, y 0.05-0.15 m).
+struct FallingParcels {
+  explicit FallingParcels(const std::vector<double>& xs) {
+    for (const double x : xs) dem.addParticle(Eigen::Vector3d(x, y0, 0.02));
+  }
+  static constexpr double y0 = 0.25;
+  const rcfd::Scene scene = rcfd::loadScene(boxScene());
+  const rcfd::Apparatus box{scene.apparatus};
+  const rcfd::CartesianGrid grid = rcfd::makeGrid(box, scene.grid);
+  rcfd::DemSystem dem{rcfd::DemMaterial::fromScene(scene), rcfd::DemWalls::box(box.lowerCorner(), box.upperCorner()),
+                      rcfd::DemSystem::settingsFromScene(scene)};
+};
+
 // Parcels released at rest fall through the spray-zone cone: each stay lasts from crossing y_max
 // (or the cone's side) to crossing y_min, t = sqrt(2 h / g) at each height; the recorder sampled at
 // 1 kHz must find every duration within one sample, and the holdup at each sample exactly.
 TEST(ReferenceRecorder, FreeFallThroughTheSprayZoneGivesTheKinematicStays) {
-  const rcfd::Scene scene = rcfd::loadScene(boxScene());
-  const rcfd::Apparatus box(scene.apparatus);
-  const rcfd::CartesianGrid grid = rcfd::makeGrid(box, scene.grid);
-  rcfd::DemSystem dem(rcfd::DemMaterial::fromScene(scene),
-                      rcfd::DemWalls::box(box.lowerCorner(), box.upperCorner()),
-                      rcfd::DemSystem::settingsFromScene(scene));
-  const double y0 = 0.25, g = 9.81, tanA = std::tan(30.0 * std::numbers::pi / 180.0);
   const std::vector<double> xs = {-0.02, -0.005, 0.0, 0.01, 0.035, 0.045};
-  for (const double x : xs) dem.addParticle(Eigen::Vector3d(x, y0, 0.02));
+  FallingParcels fall(xs);
+  const rcfd::Scene& scene = fall.scene;
+  const rcfd::CartesianGrid& grid = fall.grid;
+  rcfd::DemSystem& dem = fall.dem;
+  const double y0 = FallingParcels::y0, g = 9.81, tanA = std::tan(30.0 * std::numbers::pi / 180.0);
   const auto p = rcfd::DatabaseSchedule::fromScene(scene);
   rcfd::ReferenceRecorder rec(scene, grid, xs.size(), p.sampleDt(), 0);
   const std::vector<Eigen::Vector3d> noVelocity(std::size_t(grid.cellCount()), Eigen::Vector3d::Zero());
@@ -278,14 +289,11 @@ TEST(ReferenceRecorder, FreeFallThroughTheSprayZoneGivesTheKinematicStays) {
 // gives the same stays and holdup; they survive a checkpoint, reach the database file in the reference
 // layout, and compared with themselves differ by nothing.
 TEST(ReferenceRecorder, TheSampledPeriodIsCountedAsTheReferencePeriodIs) {
-  const rcfd::Scene scene = rcfd::loadScene(boxScene());
-  const rcfd::Apparatus box(scene.apparatus);
-  const rcfd::CartesianGrid grid = rcfd::makeGrid(box, scene.grid);
-  rcfd::DemSystem dem(rcfd::DemMaterial::fromScene(scene),
-                      rcfd::DemWalls::box(box.lowerCorner(), box.upperCorner()),
-                      rcfd::DemSystem::settingsFromScene(scene));
   const std::vector<double> xs = {-0.02, -0.005, 0.0, 0.01, 0.035, 0.045};
-  for (const double x : xs) dem.addParticle(Eigen::Vector3d(x, 0.25, 0.02));
+  FallingParcels fall(xs);
+  const rcfd::Scene& scene = fall.scene;
+  const rcfd::CartesianGrid& grid = fall.grid;
+  rcfd::DemSystem& dem = fall.dem;
   const auto p = rcfd::DatabaseSchedule::fromScene(scene);
   const std::int64_t samples = 210;
   rcfd::ReferenceRecorder reference(scene, grid, xs.size(), p.sampleDt(), 0);
