@@ -13,7 +13,8 @@
 # Resumable: run it again with the same OUT_DIR and finished jobs are kept, interrupted ones resume
 # from their checkpoints. RCFD_REGIMES_DATABASE_JOB picks the database job variant (default
 # "database"; "database-10s" samples 10 s + 10 s where examples/jobs has it), RCFD_REGIMES_MODELS the
-# models (default "mean streams relax langevin"), RCFD_SOLVE the rcfd-solve to run (default
+# models (default "mean streams relax langevin"), RCFD_REGIMES_DEM_PATCH a JSON object merged into the
+# database job's scene_patch.dem (for example '{"frame_alpha_p": "coupling"}'), RCFD_SOLVE the rcfd-solve to run (default
 # build/rcfd-solve; a copy lets a long run go on while the build changes). Needs a build and jq.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,7 +38,9 @@ for r in "${regimes[@]}"; do
   # The example's database job, with velocity_streams among the scene's effects: the database then
   # carries the velocity spread the streams model reads (the mean model ignores it).
   jq --arg scene "$scene" --argjson effects "$(jq '.effects + ["velocity_streams"]' "$scene")" \
-    '.scene_file = $scene | .scene_patch = ((.scene_patch // {}) + {effects: $effects})' "$example" > "$out/db-$r.json"
+    --argjson dem "${RCFD_REGIMES_DEM_PATCH:-{\}}" \
+    '.scene_file = $scene | .scene_patch = ((.scene_patch // {}) + {effects: $effects})
+     | if $dem == {} then . else .scene_patch.dem = ((.scene_patch.dem // {}) + $dem) end' "$example" > "$out/db-$r.json"
   if [ ! -f "$out/db-$r/summary.json" ]; then
     echo "== $r: database job $(basename "$example") with the velocity spread (log $out/db-$r.log)"
     "$solve" run "$out/db-$r.json" --out "$out/db-$r" > "$out/db-$r.log" 2>&1

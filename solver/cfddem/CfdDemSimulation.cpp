@@ -182,6 +182,11 @@ std::vector<double> CfdDemSimulation::particleFraction() const {
   // From the current parcels (the coupling's own field is that of the start of the last coupling
   // step), so a sampled frame's alpha_P, u_P and u_G belong to the same instant.
   if (coupling_->fluid) return coupling_->fluid->currentFraction();
+  return parcelFraction();
+}
+
+std::vector<double> CfdDemSimulation::parcelFraction() const {
+  if (coupling_->fluid) return coupling_->fluid->currentFraction(/*smoothed=*/false);
   const auto& map = coupling_->map();
   std::vector<coupling::KernelWeights> w;
   std::vector<double> volume;

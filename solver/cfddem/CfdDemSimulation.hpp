@@ -88,6 +88,10 @@ class CfdDemSimulation {
   /// alpha_P per cell of the current parcels, processed as the coupling does (smoothing when enabled,
   /// over-packing redistribution) [-]: the same instant as particleVelocity() and gasVelocity().
   std::vector<double> particleFraction() const;
+  /// alpha_P per cell of the current parcels' own kernel volume, over-packing redistributed as the
+  /// coupling does but not smoothed [-]: the field particleVelocity() is the velocity of, so that
+  /// alpha_P u_P is the parcels' volume flux (with smoothing off, particleFraction() itself).
+  std::vector<double> parcelFraction() const;
   /// Volume-weighted mean parcel velocity per cell, zero where a cell holds no particle volume [m/s].
   std::vector<Eigen::Vector3d> particleVelocity() const;
   /// 1 for the cells a parcel maps volume to (before smoothing): those particleVelocity() is the

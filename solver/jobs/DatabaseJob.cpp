@@ -81,7 +81,7 @@ constexpr int kSmoothedLayers = 3;
 /// only the smoothing gave particle volume get the velocity of the volume next to them.
 FieldFrame sampleFrame(const CfdDemSimulation& sim, const std::vector<float>& openFraction, bool withSpread) {
   FieldFrame f;
-  const auto alpha = sim.particleFraction();
+  const auto alpha = sim.scene().dem.frame_alpha_p == "parcels" ? sim.parcelFraction() : sim.particleFraction();
   f.alpha_p.assign(alpha.begin(), alpha.end());
   f.u_g = interleaved(sim.gasVelocity());
   if (!withSpread) {

@@ -122,6 +122,9 @@ struct DemSpec {
   double probe_rate = 1000.0;              ///< reference series (probes, pressure drop, holdup) [Hz]
   double sample_duration = 10.0;           ///< sampled period [s]
   double reference_duration = 10.0;        ///< period after sampling for reference statistics [s]
+  /// alpha_P the frames record: "parcels" (the parcels' own kernel volume, whose velocity u_P is, so
+  /// alpha_P u_P is their flux) or "coupling" (as the gas sees it, smoothed by Eq. (3) when enabled)
+  std::string frame_alpha_p = "coupling";
 };
 
 struct PathSpec {

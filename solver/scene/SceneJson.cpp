@@ -120,6 +120,7 @@ Scene sceneFromJson(const json& document) {
   read(d, "probe_rate", s.dem.probe_rate);
   read(d, "sample_duration", s.dem.sample_duration);
   read(d, "reference_duration", s.dem.reference_duration);
+  read(d, "frame_alpha_p", s.dem.frame_alpha_p);
 
   const json& r = section(document, "rcfd");
   read(r, "dt", s.rcfd.dt);
@@ -203,7 +204,7 @@ json sceneToJson(const Scene& s) {
                 {"rolling_friction", pair(d.rolling_friction)}, {"settle_time", d.settle_time},
                 {"ramp_time", d.ramp_time}, {"warmup", d.warmup}, {"sample_rate", d.sample_rate},
                 {"probe_rate", d.probe_rate}, {"sample_duration", d.sample_duration},
-                {"reference_duration", d.reference_duration}};
+                {"reference_duration", d.reference_duration}, {"frame_alpha_p", d.frame_alpha_p}};
   const auto& r = s.rcfd;
   doc["rcfd"] = {{"dt", r.dt}, {"tracers", r.tracers}, {"d0", r.d0}, {"u_fluc_max", r.u_fluc_max},
                  {"free_flight_alpha", r.free_flight_alpha}, {"langevin_time", r.langevin_time}, {"fluctuation_model", r.fluctuation_model},

@@ -366,6 +366,45 @@ TEST_F(DatabaseJob, GasJobStoppedAndResumedEqualsUninterrupted) {
   EXPECT_GT(largest, 0.1f);
 }
 
+// dem.frame_alpha_p only changes what the frames record: the same simulation (the reference series bit
+// for bit), frames whose alpha_P holds the same particle volume, but the parcels' own, unsmoothed, which
+// leaves the cells the smoothing alone reaches empty.
+TEST_F(DatabaseJob, TheFramesRecordTheParcelsOwnAlphaWhenAskedFromTheSameSimulation) {
+  json scene = gasScene();
+  writeJob(scene, "coupling.json");
+  scene["dem"]["frame_alpha_p"] = "parcels";
+  writeJob(scene, "parcels.json");
+  ASSERT_EQ(solve(run("c", "", "coupling.json")).exitCode, 0);
+  ASSERT_EQ(solve(run("p", "", "parcels.json")).exitCode, 0);
+  rcfd::h5::File fc((dir_ / "c" / "database.h5").string(), rcfd::h5::File::Mode::ReadOnly),
+      fp((dir_ / "p" / "database.h5").string(), rcfd::h5::File::Mode::ReadOnly);
+  for (const char* set : {"/reference/holdup/particles", "/reference/pressure_drop/pa", "/reference/probes/u_p_y"})
+    EXPECT_EQ(fc.readDoubles(set), fp.readDoubles(set)) << set;
+  auto dc = rcfd::FieldDatabase::open((dir_ / "c" / "database.h5").string());
+  auto dp = rcfd::FieldDatabase::open((dir_ / "p" / "database.h5").string());
+  ASSERT_EQ(dc->frameCount(), dp->frameCount());
+  const auto& open = dc->fluidFraction();
+  const double cellVolume = dc->grid().cellVolume();
+  int sharper = 0;
+  for (int n = 0; n < dc->frameCount(); ++n) {
+    const auto c = dc->frame(n), p = dp->frame(n);
+    EXPECT_EQ(c->u_g, p->u_g) << "frame " << n;
+    double volumeC = 0.0, volumeP = 0.0;
+    long occupiedC = 0, occupiedP = 0;
+    for (std::size_t i = 0; i < open.size(); ++i) {
+      volumeC += double(c->alpha_p[i]) * open[i] * cellVolume;
+      volumeP += double(p->alpha_p[i]) * open[i] * cellVolume;
+      occupiedC += c->alpha_p[i] > 0.0f;
+      occupiedP += p->alpha_p[i] > 0.0f;
+    }
+    EXPECT_NEAR(volumeP, volumeC, 1e-5 * volumeC) << "frame " << n;
+    EXPECT_LE(occupiedP, occupiedC) << "frame " << n;
+    sharper += occupiedP < occupiedC;
+  }
+  EXPECT_GT(sharper, 0);
+  EXPECT_EQ(json::parse(fp.readString("/scene"))["dem"]["frame_alpha_p"], "parcels");  // the database says which
+}
+
 // A scene that asks for the coverage gets the full simulation's own: the spray model on the parcels over
 // the reference period, one value per parcel, books that close, stepped at the reference samples.
 TEST_F(DatabaseJob, RecordsTheReferenceCoverageWhenTheSceneAsksForTheCoverage) {

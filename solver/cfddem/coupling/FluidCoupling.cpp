@@ -35,12 +35,12 @@ std::vector<Eigen::Vector3d> FluidCoupling::gasVelocitySeen() const {
   return u;
 }
 
-std::vector<double> FluidCoupling::currentFraction() const {
+std::vector<double> FluidCoupling::currentFraction(bool smoothed) const {
   std::vector<KernelWeights> w;
   std::vector<double> volume;
   mapping_->weightsOf(dem_.particles(), w);
   mapping_->scatterVolume(dem_.particles(), w, volume);
-  if (smoother_) {
+  if (smoother_ && smoothed) {
     std::vector<double> a = mapping_->fractionOf(volume);
     smoother_->smooth(a);
     for (std::size_t c = 0; c < a.size(); ++c) volume[c] = a[c] * mapping_->openVolume(c);

@@ -44,9 +44,9 @@ class FluidCoupling {
 
   /// True once prepare() ran (or a checkpoint was restored): particleFraction() is the coupling's.
   bool prepared() const { return !first_; }
-  /// alpha_P of the current parcels, processed as prepare() does (smoothing, redistribution), without
-  /// touching the gas [-].
-  std::vector<double> currentFraction() const;
+  /// alpha_P of the current parcels, processed as prepare() does (smoothing when `smoothed` and
+  /// enabled, redistribution), without touching the gas [-].
+  std::vector<double> currentFraction(bool smoothed = true) const;
   /// alpha_P per cell after smoothing and redistribution [-].
   const std::vector<double>& particleFraction() const { return alphaP_; }
   const std::vector<double>& gasFraction() const { return alphaG_; }
