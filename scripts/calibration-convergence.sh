@@ -38,7 +38,7 @@ for count in "${counts[@]}"; do
   for seed in $seeds; do
     dir=$out/t$n-s$seed
     jq -n --arg scene "$scene" --arg db "$db" --argjson n "$n" --argjson seed "$seed" --argjson effects "$effects" \
-      '{kind: "calibration", scene_file: $scene, scene_patch: ({rcfd: {tracers: $n}} + $effects), database: $db,
+      '{kind: "calibration", scene_file: $scene, scene_patch: ({rcfd: {tracers: $n}} * $effects), database: $db,
         duration: 10.0, discard: 2.0, seed: $seed, checkpoint_interval: 5.0,
         d0_values: [0, 1e-5, 1e-4, 5e-4, 1e-3, 1e-2, 3e-2, 1e-1]}' > "$dir.json"
     [ -f "$dir/summary.json" ] || "$solve" run "$dir.json" --out "$dir" > "$dir.log" 2>&1

@@ -5,10 +5,13 @@
 #   relax    Eq. (9) with directed_relaxation (the directed flux down the excess gradient)
 #   langevin the relax model with langevin_velocity (the velocity spread as an Ornstein-Uhlenbeck
 #            fluctuation)
+# and each of them with the suffix "-mw" (e.g. mean-mw): the same with rcfd.velocity_interpolation
+# "mass_weighted" (the particle flux between cell centres).
 # Shared by scripts/regimes.sh and scripts/calibration-convergence.sh.
 def relaxation($name): map(if . == "fluctuation" or . == "directed_relaxation" then $name else . end);
 def withoutStreams: map(select(. != "velocity_streams" and . != "langevin_velocity"));
-if $model == "mean" then {effects: (.effects | withoutStreams | relaxation("fluctuation"))}
+($model | endswith("-mw")) as $weighted | ($model | sub("-mw$"; "")) as $model |
+(if $model == "mean" then {effects: (.effects | withoutStreams | relaxation("fluctuation"))}
 elif $model == "streams" then
   {effects: (.effects | withoutStreams | relaxation("fluctuation")
              | (.[0:index("transport") + 1] + ["velocity_streams"] + .[index("transport") + 1:]))}
@@ -16,4 +19,5 @@ elif $model == "relax" then {effects: (.effects | withoutStreams | relaxation("d
 elif $model == "langevin" then
   {effects: (.effects | withoutStreams | relaxation("directed_relaxation")
              | (.[0:index("directed_relaxation") + 1] + ["langevin_velocity"] + .[index("directed_relaxation") + 1:]))}
-else error("unknown model \($model): mean, streams, relax or langevin") end
+else error("unknown model \($model): mean, streams, relax or langevin, each also with -mw") end)
+| if $weighted then . + {rcfd: {velocity_interpolation: "mass_weighted"}} else . end

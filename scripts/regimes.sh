@@ -5,7 +5,7 @@
 # (the spout on cells of 3.7 parcel diameters, several parcels per cell), the database
 # job, then a calibration per tracer motion model (scripts/model-effects.jq: "mean", Eq. (9) with
 # Eq. (10); "streams", the two-stream velocity; "relax", directed relaxation instead of Eq. (10);
-# "langevin", relax with the Langevin velocity), a
+# "langevin", relax with the Langevin velocity; each also with "-mw", the mass-weighted velocity), a
 # spray job of each at its selected D0 with one tracer per parcel over the reference
 # period (its coverage distribution against the full simulation's), and a table of what each selects
 # and how its spray-zone stays and coverage compare.
@@ -61,7 +61,7 @@ for r in "${regimes[@]}"; do
     jq -n --arg scene "$scene" --arg db "$out/db-$r/database.h5" --argjson patch "$patch" \
       --argjson d0 "$(jq '.selected_d0' "$out/cal-$r-$model/summary.json")" \
       --argjson tracers "$(jq '.particles' "$out/db-$r/summary.json")" --argjson duration "$duration" \
-      '{kind: "spray", scene_file: $scene, scene_patch: ($patch + {rcfd: {d0: $d0, tracers: $tracers}}),
+      '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: {d0: $d0, tracers: $tracers}}),
         database: $db, duration: $duration, seed: 1, checkpoint_interval: 60.0}' > "$out/spray-$r-$model.json"
     if [ ! -f "$out/spray-$r-$model/summary.json" ]; then
       echo "== $r: spray over the reference period, $model (log $out/spray-$r-$model.log)"

@@ -149,6 +149,8 @@ struct RcfdSpec {
   /// Fields between two frames when dt < dt_rec: "hold" (each frame over its whole interval) or
   /// "linear" (the two frames blended)
   std::string frame_interpolation = "hold";
+  /// u_P^rec between cell centres: "trilinear" or "mass_weighted" (the particle flux over alpha_P)
+  std::string velocity_interpolation = "trilinear";
   long frame_cache_bytes = 0;       ///< 0: load all frames into RAM; else LRU cache size [bytes]
   PathSpec path;
 };

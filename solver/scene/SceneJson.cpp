@@ -133,6 +133,7 @@ Scene sceneFromJson(const json& document) {
   read(r, "max_courant", s.rcfd.max_courant);
   read(r, "integrator", s.rcfd.integrator);
   read(r, "frame_interpolation", s.rcfd.frame_interpolation);
+  read(r, "velocity_interpolation", s.rcfd.velocity_interpolation);
   read(r, "frame_cache_bytes", s.rcfd.frame_cache_bytes);
   const json& path = section(r, "path");
   read(path, "type", s.rcfd.path.type);
@@ -210,6 +211,7 @@ json sceneToJson(const Scene& s) {
                  {"free_flight_alpha", r.free_flight_alpha}, {"langevin_time", r.langevin_time}, {"fluctuation_model", r.fluctuation_model},
                  {"max_courant", r.max_courant}, {"integrator", r.integrator},
                  {"frame_interpolation", r.frame_interpolation},
+                 {"velocity_interpolation", r.velocity_interpolation},
                  {"frame_cache_bytes", r.frame_cache_bytes},
                  {"path", {{"type", r.path.type}, {"min_sequence_fraction", r.path.min_sequence_fraction},
                            {"max_sequence_fraction", r.path.max_sequence_fraction},

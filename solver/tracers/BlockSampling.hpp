@@ -56,6 +56,24 @@ inline void interpolateCorners(const float* field, const std::int32_t* off, floa
   }
 }
 
+/// interpolateCorners() of a mass-weighted step field, (w u_x, w u_y, w u_z, w) per cell: the four
+/// components combined alike, then the momentum divided by the weight (StepVelocityField::build()).
+inline void interpolateWeightedCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
+                                       float out[3]) {
+  float v[4];
+  for (int d = 0; d < 4; ++d) {
+    float t[4];
+    for (int j = 0; j < 4; ++j) {
+      const float a = field[off[j] + d], b = field[off[j + 4] + d];
+      t[j] = std::fma(fz, b - a, a);
+    }
+    const float s0 = std::fma(fy, t[2] - t[0], t[0]);
+    const float s1 = std::fma(fy, t[3] - t[1], t[1]);
+    v[d] = std::fma(fx, s1 - s0, s0);
+  }
+  for (int d = 0; d < 3; ++d) out[d] = v[d] / v[3];
+}
+
 /// Base indices and fractions of the points (x, y, z) of a block, into `s`.
 inline void locateBlock(const TrilinearLocator::Constants& q, int count, const double* x, const double* y,
                         const double* z, BlockStencils& s) {
@@ -153,8 +171,11 @@ inline void locateGridBlock(const GridConstants& q, int count, const float* gx, 
 /// layer in x).
 struct CornerOffsets {
   std::int32_t off[8] = {};
-  int stride = 4;  ///< floats per cell: 4 (x, y, z, 0), or 3 (x, y, z) on a frame's own array
+  int stride = 4;  ///< floats per cell: 4 (x, y, z, w), or 3 (x, y, z) on a frame's own array
   bool pairLoads = false;
+  /// The field is mass-weighted, (w u, w) per cell: samples divide by the interpolated w. Every padded
+  /// field has w = 1 where it is not, so a plain field read this way gives exactly its plain samples.
+  bool weighted = false;
   void set(const std::int32_t* cellOffsets, int floatsPerCell = 4) {
     stride = floatsPerCell;
     pairLoads = stride == 4;
@@ -181,7 +202,8 @@ inline void sampleBlock3(const float* field, const CornerOffsets& co, const Bloc
       const __m256 t23 = _mm256_fmadd_ps(fz, _mm256_sub_ps(_mm256_loadu_ps(c + o6), c23), c23);
       const __m256 s01 = _mm256_fmadd_ps(_mm256_set1_ps(s.fy[k]), _mm256_sub_ps(t23, t01), t01);
       const __m128 s0 = _mm256_castps256_ps128(s01), s1 = _mm256_extractf128_ps(s01, 1);
-      const __m128 u = _mm_fmadd_ps(_mm_set1_ps(s.fx[k]), _mm_sub_ps(s1, s0), s0);
+      __m128 u = _mm_fmadd_ps(_mm_set1_ps(s.fx[k]), _mm_sub_ps(s1, s0), s0);
+      if (co.weighted) u = _mm_div_ps(u, _mm_shuffle_ps(u, u, _MM_SHUFFLE(3, 3, 3, 3)));
       _mm_store_ss(ux + k, u);
       uy[k] = std::bit_cast<float>(_mm_extract_ps(u, 1));
       uz[k] = std::bit_cast<float>(_mm_extract_ps(u, 2));
@@ -191,7 +213,11 @@ inline void sampleBlock3(const float* field, const CornerOffsets& co, const Bloc
 #endif
   for (int k = 0; k < count; ++k) {
     float u[3];
-    interpolateCorners(field + co.stride * std::int64_t(s.base[k]), co.off, s.fx[k], s.fy[k], s.fz[k], u);
+    if (co.weighted) {
+      interpolateWeightedCorners(field + co.stride * std::int64_t(s.base[k]), co.off, s.fx[k], s.fy[k], s.fz[k], u);
+    } else {
+      interpolateCorners(field + co.stride * std::int64_t(s.base[k]), co.off, s.fx[k], s.fy[k], s.fz[k], u);
+    }
     ux[k] = u[0], uy[k] = u[1], uz[k] = u[2];
   }
 }

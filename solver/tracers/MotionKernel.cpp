@@ -129,6 +129,7 @@ block::Context MotionKernel::blockContext(const TrilinearLocator& locator, doubl
   bc.q = locator.constants();
   bc.grid = block::GridConstants(bc.q);
   bc.corners.set(locator.offsets32());
+  bc.corners.weighted = particleVelocity_->weighted();  // u_G's padded field has weight 1: read alike
   for (int d = 0; d < 3; ++d) {
     bc.origin[d] = grid_.origin[d], bc.inv[d] = 1.0 / grid_.spacing[d], bc.spacing[d] = grid_.spacing[d];
     bc.last[d] = grid_.shape[d] - 1;

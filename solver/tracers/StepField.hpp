@@ -35,12 +35,17 @@ class StepVelocityField {
   /// step on a frame refers to the frame's array, which must outlive the field's use (the step's frames
   /// are held for the step: TracerContext, StepFields).
   void build(const FrameSampler& sampler, bool useGas, bool parallel,
-             StepFieldLayout layout = StepFieldLayout::Padded) {
+             StepFieldLayout layout = StepFieldLayout::Padded, float massWeight = 0.0f) {
     const auto& fa = useGas ? sampler.frame().u_g : sampler.frame().u_p;
     const FieldFrame* next = sampler.nextFrame();
     frameValues_ = nullptr;
+    weighted_ = false;
     if (!next && layout == StepFieldLayout::Any) {
       frameValues_ = fa.data();
+      return;
+    }
+    if (massWeight > 0.0f && !useGas) {
+      buildWeighted(sampler, parallel, massWeight);
       return;
     }
     const float* fb = next ? (useGas ? next->u_g : next->u_p).data() : nullptr;
@@ -55,7 +60,7 @@ class StepVelocityField {
         for (int d = 0; d < 3; ++d) {
           out[4 * c + d] = float(double(a[3 * c + d]) + w * (double(fb[3 * c + d]) - double(a[3 * c + d])));
         }
-        out[4 * c + 3] = 0.0f;
+        out[4 * c + 3] = 1.0f;
       }
       return;
     }
@@ -65,20 +70,47 @@ class StepVelocityField {
 #pragma omp parallel for schedule(static) if (parallel)
     for (std::int64_t c = 0; c < cells; ++c) {
 #if defined(__AVX512F__) && defined(__AVX512VL__)
-      _mm_store_ps(out + 4 * c, _mm_maskz_loadu_ps(0x7, a + 3 * c));  // (x, y, z, 0), no read past z
+      _mm_store_ps(out + 4 * c, _mm_mask_loadu_ps(_mm_set1_ps(1.0f), 0x7, a + 3 * c));  // (x, y, z, 1), no read past z
 #else
       for (int d = 0; d < 3; ++d) out[4 * c + d] = a[3 * c + d];
-      out[4 * c + 3] = 0.0f;
+      out[4 * c + 3] = 1.0f;
 #endif
     }
   }
 
-  /// The field as stride() floats per cell: (x, y, z, 0), or (x, y, z) on a frame's own array.
+  /// The field as stride() floats per cell: (x, y, z, 1), (w u, w) when weighted(), or (x, y, z) on a
+  /// frame's own array.
   const float* floats() const { return frameValues_ ? frameValues_ : (data_.empty() ? nullptr : data_[0].data()); }
   int stride() const { return frameValues_ ? 3 : 4; }
   bool padded() const { return !frameValues_; }
+  bool weighted() const { return weighted_; }
 
  private:
+  /// (w u_P, w) per cell with w = alpha_P^rec + massWeight, each blended between the frames: a sample
+  /// between cell centres is then the particle flux over the particle volume there (the cells'
+  /// alpha_P u_P and alpha_P interpolated alike), a cell centre's is its own u_P.
+  void buildWeighted(const FrameSampler& sampler, bool parallel, float massWeight) {
+    const FieldFrame& fa = sampler.frame();
+    const FieldFrame* fb = sampler.nextFrame();
+    const double w = sampler.blend();
+    const std::int64_t cells = std::int64_t(fa.alpha_p.size());
+    data_.resize(std::size_t(cells));
+    float* const out = data_.empty() ? nullptr : data_[0].data();
+#pragma omp parallel for schedule(static) if (parallel)
+    for (std::int64_t c = 0; c < cells; ++c) {
+      const double wa = double(fa.alpha_p[std::size_t(c)]) + massWeight;
+      const double wb = fb ? double(fb->alpha_p[std::size_t(c)]) + massWeight : wa;
+      for (int d = 0; d < 3; ++d) {
+        const double ma = wa * fa.u_p[std::size_t(3 * c + d)];
+        const double mb = fb ? wb * fb->u_p[std::size_t(3 * c + d)] : ma;
+        out[4 * c + d] = float(ma + w * (mb - ma));
+      }
+      out[4 * c + 3] = float(wa + w * (wb - wa));
+    }
+    weighted_ = true;
+  }
+
+  bool weighted_ = false;
   const float* frameValues_ = nullptr;  ///< the frame's own u (layout Any, on a frame), else null
   std::vector<Eigen::Array4f> data_;
 };
@@ -90,6 +122,9 @@ class StepVelocityField {
 class StepFields {
  public:
   void invalidate() { built_[0] = built_[1] = false; }
+  /// u_P^rec mass-weighted with weight alpha_P^rec + `epsilon` (StepVelocityField::buildWeighted());
+  /// 0: plain trilinear velocity.
+  void setMassWeight(float epsilon) { massWeight_ = epsilon; invalidate(); }
   /// u_P^rec (useGas false) or u_G^rec of the sampler's frames: the one built ahead for these frames,
   /// if any, else built now.
   /// With layout Any, a field already built padded this step is returned as it is; a padded request
@@ -103,7 +138,7 @@ class StepFields {
           a.blend == sampler.blend()) {
         std::swap(fields_[k], a.field);  // the same build(), done earlier
       } else {
-        fields_[k].build(sampler, useGas, parallel, layout);
+        fields_[k].build(sampler, useGas, parallel, layout, massWeight_);
       }
       a.frame.reset(), a.next.reset();
       built_[k] = true;
@@ -117,7 +152,7 @@ class StepFields {
                   std::shared_ptr<const FieldFrame> next, double blend, bool useGas) {
     Ahead& a = ahead_[useGas ? 1 : 0];
     const FrameSampler sampler(grid, frame.get(), next.get(), blend);
-    a.field.build(sampler, useGas, false);
+    a.field.build(sampler, useGas, false, StepFieldLayout::Padded, massWeight_);
     a.frame = std::move(frame);
     a.next = sampler.nextFrame() ? std::move(next) : nullptr;
     a.blend = sampler.blend();
@@ -131,6 +166,7 @@ class StepFields {
   };
   StepVelocityField fields_[2];
   bool built_[2] = {false, false};
+  float massWeight_ = 0.0f;
   Ahead ahead_[2];
 };
 
@@ -142,6 +178,7 @@ class StepFieldSampler {
   StepFieldSampler(const StepVelocityField& field, const TrilinearLocator& locator)
       : values_(field.floats()), stride_(field.stride()), locator_(locator), grid_(locator.constants()) {
     corners_.set(locator.offsets32(), stride_);
+    corners_.weighted = field.weighted();
   }
   /// Grid coordinates of p in float (block::gridCoordinate()): where the motion kernel's u_P^rec
   /// samples and midpoints are taken.
@@ -154,7 +191,7 @@ class StepFieldSampler {
     float f[3];
     const std::int32_t base = grid_.locate(g.x(), g.y(), g.z(), f[0], f[1], f[2]);
     Eigen::Vector3f u;
-    block::interpolateCorners(values_ + stride_ * std::int64_t(base), corners_.off, f[0], f[1], f[2], u.data());
+    interpolate(values_ + stride_ * std::int64_t(base), f[0], f[1], f[2], u.data());
     return u;
   }
   /// The inverse grid spacing in float, per axis (midpoints in grid coordinates).
@@ -163,12 +200,19 @@ class StepFieldSampler {
   Eigen::Vector3d sample(const Eigen::Vector3d& p) const {
     const TrilinearStencil s = locator_.locate(p);
     float u[3];
-    block::interpolateCorners(values_ + stride_ * s.base, corners_.off, float(s.f[0]), float(s.f[1]),
-                              float(s.f[2]), u);
+    interpolate(values_ + stride_ * s.base, float(s.f[0]), float(s.f[1]), float(s.f[2]), u);
     return {double(u[0]), double(u[1]), double(u[2])};
   }
 
  private:
+  void interpolate(const float* at, float fx, float fy, float fz, float u[3]) const {
+    if (corners_.weighted) {
+      block::interpolateWeightedCorners(at, corners_.off, fx, fy, fz, u);
+    } else {
+      block::interpolateCorners(at, corners_.off, fx, fy, fz, u);
+    }
+  }
+
   const float* values_;  ///< the field's floats, taken when constructed
   int stride_;
   const TrilinearLocator& locator_;

@@ -62,6 +62,7 @@ TracerSimulation::TracerSimulation(const Scene& scene, std::shared_ptr<const Fie
   ctx.openVolume.resize(fluid.size());
   for (std::size_t c = 0; c < fluid.size(); ++c) ctx.openVolume[c] = fluid[c] * ctx.grid.cellVolume();
   ctx.plateFaces = plateFacesAbove(*apparatus_, ctx.grid);
+  if (velocityInterpolation(scene_) == VelocityInterpolation::MassWeighted) ctx.stepFields.setMassWeight(kMassWeightFloor);
 
   loadFrames();
   placeTracers();

@@ -59,6 +59,7 @@ TEST(Choices, SceneSchemaEnumsAreTheRegisteredNames) {
   EXPECT_EQ(schemaEnum("scene", p + "gas/properties/pressure_preconditioner"), gas::PreconditionerRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/integrator"), namesOf(kTracerIntegrators));
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/frame_interpolation"), namesOf(kFrameInterpolations));
+  EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/velocity_interpolation"), namesOf(kVelocityInterpolations));
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/fluctuation_model"), FluctuationModelRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "rcfd/properties/path/properties/type"), PathGeneratorRegistry::names());
   EXPECT_EQ(schemaEnum("scene", p + "spray/properties/deposition_model"), DepositionModelRegistry::names());
@@ -99,6 +100,12 @@ TEST(Choices, UnknownIntegratorAndNormAreInputErrorsNamingTheValidOnes) {
   for (const auto& i : kFrameInterpolations) {
     s.rcfd.frame_interpolation = i.name;
     EXPECT_EQ(frameInterpolation(s), i.value);
+  }
+  s.rcfd.velocity_interpolation = "cubic";
+  expectUnknownNameAt([&] { velocityInterpolation(s); }, "/rcfd/velocity_interpolation", {"mass_weighted", "trilinear"});
+  for (const auto& i : kVelocityInterpolations) {
+    s.rcfd.velocity_interpolation = i.name;
+    EXPECT_EQ(velocityInterpolation(s), i.value);
   }
 }
 

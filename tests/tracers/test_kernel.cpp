@@ -458,6 +458,7 @@ struct RandomCaseResult {
   double worst = 0.0, shareApart = 0.0;
   double meanMove = 0.0;  ///< mean distance a tracer moved over the steps [m]
   std::int64_t substeps = 0, freeFlying = 0, wallHits = 0, capped = 0;
+  bool massWeighted = false;
   std::string description;
 };
 
@@ -502,6 +503,8 @@ RandomCaseResult blockAgainstReferenceOnARandomCase(std::uint64_t seed) {
     for (const auto& m : modes[std::size_t(component)]) value += m.amplitude * std::sin(m.k.dot(p) + m.phase + 3.0 * t);
     return value / 3.0;  // in [-1, 1]
   };
+  const bool massWeighted = unit(rng) < 0.5;
+  if (massWeighted) s.rcfd.velocity_interpolation = "mass_weighted";
   const CartesianGrid grid = gridOf(s);
   auto db = database(s, 4, s.rcfd.dt, [&](int, double t, FieldFrame& f) {
     for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
@@ -539,9 +542,11 @@ RandomCaseResult blockAgainstReferenceOnARandomCase(std::uint64_t seed) {
     r.meanMove += (fast.cloud().position(i) - start[std::size_t(fast.cloud().id[i])]).norm() / double(fast.cloud().size());
   }
   r.shareApart = double(apart) / double(fast.cloud().size());
+  r.massWeighted = massWeighted;
   r.description = "seed " + std::to_string(seed) + ": apparatus " + std::to_string(apparatus) + ", D0 " +
                   std::to_string(s.rcfd.d0) + ", " + s.rcfd.integrator + ", free flight " + std::to_string(freeFlight) +
-                  ", fluctuation " + std::to_string(fluctuation) + ", speed " + std::to_string(speed) + " m/s";
+                  ", fluctuation " + std::to_string(fluctuation) + ", speed " + std::to_string(speed) + " m/s, " +
+                  s.rcfd.velocity_interpolation;
   return r;
 }
 }  // namespace
@@ -551,7 +556,7 @@ RandomCaseResult blockAgainstReferenceOnARandomCase(std::uint64_t seed) {
 // the same random streams. They may differ only where a fused multiply-add rounds differently: every
 // tracer within 1e-9 m after 10 steps (on the AVX2 build they agree bit for bit).
 TEST(Kernel, BlockPathMatchesTheReferenceMotionOnRandomCases) {
-  std::int64_t substeps = 0, freeFlying = 0, wallHits = 0, capped = 0;
+  std::int64_t substeps = 0, freeFlying = 0, wallHits = 0, capped = 0, massWeighted = 0;
   for (std::uint64_t seed = 1; seed <= 16; ++seed) {
     const RandomCaseResult r = blockAgainstReferenceOnARandomCase(seed);
     std::cout << r.description << ": moved " << r.meanMove << " m on average, worst difference " << r.worst
@@ -559,8 +564,11 @@ TEST(Kernel, BlockPathMatchesTheReferenceMotionOnRandomCases) {
     EXPECT_LT(r.worst, 1e-9) << r.description << ": " << 100.0 * r.shareApart << " % apart";
     EXPECT_GT(r.meanMove, 1e-4) << r.description;
     substeps += r.substeps, freeFlying += r.freeFlying, wallHits += r.wallHits, capped += r.capped;
+    massWeighted += r.massWeighted;
   }
-  // The cases took every way of moving.
+  // The cases took every way of moving, with both velocity interpolations.
+  EXPECT_GT(massWeighted, 0);
+  EXPECT_LT(massWeighted, 16);
   EXPECT_GT(substeps, 0);
   EXPECT_GT(freeFlying, 0);
   EXPECT_GT(wallHits, 0);

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "TracerTestSupport.hpp"
+#include "tracers/FrameInterpolation.hpp"
 #include "tracers/StepField.hpp"
 
 using namespace rcfd;
@@ -73,8 +74,9 @@ TEST(StepFields, AFieldBuiltAheadForOtherFramesIsNotTaken) {
 
 }  // namespace
 
-TEST(StepFields, AFieldHoldsItsFramesValuesPaddedWithZero) {
-  // On a frame (a copy, the vector path) and between two (the blend in double): (x, y, z, 0) per cell.
+TEST(StepFields, AFieldHoldsItsFramesValuesPaddedWithOne) {
+  // On a frame (a copy, the vector path) and between two (the blend in double): (x, y, z, 1) per cell,
+  // the weight 1 of a field that is not mass-weighted.
   const ThreeFrames t;
   const auto f1 = t.db->frame(1), f2 = t.db->frame(2);
   for (const bool useGas : {false, true}) {
@@ -86,8 +88,8 @@ TEST(StepFields, AFieldHoldsItsFramesValuesPaddedWithZero) {
     for (std::int64_t c = 0; c < t.grid.cellCount(); ++c) {
       for (int d = 0; d < 4; ++d) {
         const std::size_t i = 3 * std::size_t(c) + std::size_t(d);
-        const float copied = d < 3 ? a[i] : 0.0f;
-        const float blended = d < 3 ? float(double(a[i]) + 0.25 * (double(b[i]) - double(a[i]))) : 0.0f;
+        const float copied = d < 3 ? a[i] : 1.0f;
+        const float blended = d < 3 ? float(double(a[i]) + 0.25 * (double(b[i]) - double(a[i]))) : 1.0f;
         wrong += onFrame.floats()[4 * c + d] != copied;
         wrong += between.floats()[4 * c + d] != blended;
       }
@@ -144,4 +146,62 @@ TEST(StepFields, LayoutAnyOnAFrameIsTheFrameItselfAndSamplesAlike) {
       fields.velocity(FrameSampler(t.grid, f1.get(), f2.get(), 0.25), true, false, StepFieldLayout::Any);
   EXPECT_EQ(between.stride(), 4);
   EXPECT_TRUE(t.equal(between, t.built(1, 2, 0.25, true)));
+}
+
+// The mass-weighted u_P field holds (w u_P, w), w = alpha_P + kMassWeightFloor, each blended between the
+// frames; sampled at a cell centre it gives the cell's u_P, halfway between two cells the flux-weighted
+// mean (w1 u1 + w2 u2) / (w1 + w2), and on a uniform alpha_P the trilinear velocity. u_G is never weighted.
+TEST(StepFields, TheMassWeightedFieldSamplesTheParticleFlux) {
+  Scene scene = boxScene({0.1, 0.1, 0.05}, 0.01, 10, 0.005, {"transport"});
+  const CartesianGrid grid = gridOf(scene);
+  auto db = database(scene, 3, 0.005, [&grid](int n, double, FieldFrame& f) {
+    for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+      const auto ijk = grid.cellIjk(c);
+      f.alpha_p[std::size_t(c)] = ijk[0] % 2 == 0 ? 0.5f : (n == 2 ? 0.1f : 0.02f);  // dense and dilute columns
+      f.u_p[3 * std::size_t(c) + 1] = ijk[0] % 2 == 0 ? -0.25f : 2.0f + float(n);
+      f.u_g[3 * std::size_t(c)] = 1.5f;
+    }
+  });
+  const auto f1 = db->frame(1), f2 = db->frame(2);
+  const TrilinearLocator locator(grid);
+  StepFields fields;
+  fields.setMassWeight(kMassWeightFloor);
+  const FrameSampler onFrame(grid, f1.get());
+  const StepVelocityField& u = fields.velocity(onFrame, false, false);
+  ASSERT_TRUE(u.weighted());
+  const StepFieldSampler sample(u, locator);
+  const Eigen::Vector3d dense = grid.cellCenter(4, 5, 2), dilute = grid.cellCenter(5, 5, 2);
+  EXPECT_NEAR(sample.sample(dense).y(), -0.25, 1e-6);
+  EXPECT_NEAR(sample.sample(dilute).y(), 3.0, 1e-6);
+  const double w1 = 0.5 + kMassWeightFloor, w2 = 0.02 + kMassWeightFloor;
+  EXPECT_NEAR(sample.sample(0.5 * (dense + dilute)).y(), (w1 * -0.25 + w2 * 3.0) / (w1 + w2), 1e-6);
+  // Between frames 1 and 2 the weights and momenta blend: a quarter of the way to frame 2.
+  fields.invalidate();
+  const FrameSampler between(grid, f1.get(), f2.get(), 0.25);
+  const StepFieldSampler blended(fields.velocity(between, false, false), locator);
+  const double b2 = w2 + 0.25 * (0.1 - 0.02), m2 = w2 * 3.0 + 0.25 * ((0.1 + kMassWeightFloor) * 4.0 - w2 * 3.0);
+  EXPECT_NEAR(blended.sample(0.5 * (dense + dilute)).y(), (w1 * -0.25 + m2) / (w1 + b2), 1e-5);
+  // u_G: not weighted, weight 1 read as such.
+  const StepVelocityField& gas = fields.velocity(between, true, false);
+  EXPECT_FALSE(gas.weighted());
+  EXPECT_NEAR(StepFieldSampler(gas, locator).sample(0.5 * (dense + dilute)).x(), 1.5, 1e-6);
+  // A uniform alpha_P gives the trilinear velocity.
+  auto uniform = database(scene, 3, 0.005, [&grid](int, double, FieldFrame& f) {
+    for (std::int64_t c = 0; c < grid.cellCount(); ++c) {
+      f.alpha_p[std::size_t(c)] = 0.3f;
+      f.u_p[3 * std::size_t(c) + 1] = float(grid.cellIjk(c)[0]);
+    }
+  });
+  StepFields plainFields, weightedFields;
+  weightedFields.setMassWeight(kMassWeightFloor);
+  const auto g1 = uniform->frame(1);
+  const FrameSampler on(grid, g1.get());
+  const StepFieldSampler plain(plainFields.velocity(on, false, false), locator),
+      weighted(weightedFields.velocity(on, false, false), locator);
+  std::mt19937_64 gen(3);
+  std::uniform_real_distribution<double> px(-0.05, 0.05), py(0.0, 0.1), pz(0.0, 0.05);
+  for (int k = 0; k < 200; ++k) {
+    const Eigen::Vector3d p(px(gen), py(gen), pz(gen));
+    EXPECT_NEAR(weighted.sample(p).y(), plain.sample(p).y(), 1e-5) << p.transpose();
+  }
 }
