@@ -25,7 +25,7 @@
 # per tracer run are many times slower than one (their barriers wait for a descheduled thread).
 # A finished OpenFOAM run in WORK/case with the same JET_VELOCITY, END_TIME and WRITE_INTERVAL is kept
 # (REUSE_CASE=0 runs it again).
-# Takes about 7 minutes for MPPICFoam and 2 more for the server's jobs on 2 shared cores.
+# Takes about 7.5 minutes for MPPICFoam and half a minute for the server's jobs on 2 shared cores.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -66,7 +66,6 @@ else
 fi
 
 # --- 2. the server ---------------------------------------------------------------------------------
-mkdir -p server
 export OMP_NUM_THREADS="${OMP_NUM_THREADS:-1}"  # the solvers inherit the server's environment
 "$server_bin" --data-dir "$work/server" --listen 127.0.0.1:0 --workers 1 --solver "$solve" \
   --import-root "$work" > server.out 2> server.log &
