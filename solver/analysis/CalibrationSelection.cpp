@@ -115,9 +115,18 @@ Selection selectD0(const std::vector<D0Scores>& s, const SelectionOptions& o, bo
         break;
       }
     }
+    // Name the values that met the residence-time criterion alone, if any: they are what a wider
+    // tolerance or more tracers (a lower counting floor) would select.
+    std::string rtdOnly;
+    for (const std::size_t i : order) {
+      if (sel.residenceTimesAgree[i]) rtdOnly += (rtdOnly.empty() ? "" : ", ") + g3(s[i].d0);
+    }
+    const std::string rtdClause = rtdOnly.empty()
+        ? ", and no value met the " + rtd + " criterion"
+        : "; the " + rtd + " agree at D0 = " + rtdOnly + " m2/s, whose bed shape does not";
     sel.reason = "no D0 met both criteria; D0 = " + g3(s[sel.selected].d0) + " m2/s is the " +
                  (sel.bedShapeAgrees[sel.selected] ? "lowest whose " + bed + " agrees" : "one with the best bed shape") +
-                 " (" + scores(sel.selected) + "), and no value met the " + rtd + " criterion" + penalty;
+                 " (" + scores(sel.selected) + ")" + rtdClause + penalty;
   }
   sel.atUpperEnd = n > 1 && (sel.selected == top || sel.penaltyMinimum == top);
   return sel;

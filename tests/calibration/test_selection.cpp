@@ -99,6 +99,20 @@ TEST(Selection, FallsBackToBedShapeWhenNoRunMeetsBoth) {
   EXPECT_FALSE(sel.ruleSatisfied);
   EXPECT_EQ(s[sel.selected].d0, 5e-4);
   EXPECT_NE(sel.reason.find("no D0 met both"), std::string::npos) << sel.reason;
+  EXPECT_NE(sel.reason.find("no value met the residence times"), std::string::npos) << sel.reason;
+}
+
+// When some D0 meets the residence times but not the bed shape, the reason names it instead of saying
+// that none did.
+TEST(Selection, NamesTheValuesWhoseResidenceTimesAloneAgree) {
+  auto s = paperLike();
+  for (auto& x : s) x.ksDistance = 0.9;
+  s[1].ksDistance = 0.05, s[1].rtdMeanRelativeError = 0.01, s[1].crossingRateRelativeError = 0.02;  // 1e-5: 2 x the floor
+  const Selection sel = selectD0(s, SelectionOptions{}, true);
+  EXPECT_FALSE(sel.ruleSatisfied);
+  EXPECT_TRUE(sel.residenceTimesAgree[1]);
+  EXPECT_EQ(sel.reason.find("no value met"), std::string::npos) << sel.reason;
+  EXPECT_NE(sel.reason.find("agree at D0 = 1e-05 m2/s, whose bed shape does not"), std::string::npos) << sel.reason;
 }
 
 TEST(Selection, RunWithoutStaysHasNoAgreeingResidenceTimes) {
