@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -28,6 +29,24 @@ namespace {
 constexpr auto kProgressWriteInterval = std::chrono::milliseconds(250);  // throttle row updates
 
 }  // namespace
+
+std::vector<std::string> solverEnvironment(int workers, const char* const* environment, unsigned cores) {
+  std::vector<std::string> env;
+  bool threads = false, policy = false;
+  for (const char* const* e = environment; e && *e; ++e) {
+    const std::string entry = *e;
+    threads = threads || entry.starts_with("OMP_NUM_THREADS=");
+    policy = policy || entry.starts_with("OMP_WAIT_POLICY=");
+    env.push_back(entry);
+  }
+  if (!threads) env.push_back("OMP_NUM_THREADS=" + std::to_string(std::max(1u, cores / unsigned(std::max(1, workers)))));
+  if (!policy) env.push_back("OMP_WAIT_POLICY=passive");
+  return env;
+}
+
+std::vector<std::string> solverEnvironment(int workers) {
+  return solverEnvironment(workers, environ, std::thread::hardware_concurrency());
+}
 
 WorkerPool::WorkerPool(JobStore& store, const ServerConfig& config)
     : store_(store), config_(config) {}
@@ -134,6 +153,11 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
     const std::string outDir = dir.string();
     std::vector<const char*> argv = {solver.c_str(), "run", jobFile.c_str(), "--out",
                                      outDir.c_str(), "--progress-json", nullptr};
+    // The environment is built before the fork: nothing after it may allocate.
+    std::vector<std::string> environment = solverEnvironment(config_.workers);
+    std::vector<const char*> envp;
+    for (const auto& e : environment) envp.push_back(e.c_str());
+    envp.push_back(nullptr);
     const pid_t parent = ::getpid();
     // Solvers are batch work: nicer than the server, whose I/O threads answer polls in microseconds
     // and would otherwise queue behind a solver's threads for a scheduler slice.
@@ -157,7 +181,7 @@ void WorkerPool::runJob(JobRecord job, std::uint64_t run) {
       // The solver must not hold the server's sockets (listener, client connections): a connection
       // it kept open would outlive the server's close or be reset when the solver exits.
       ::close_range(3, ~0U, 0);
-      ::execv(argv[0], const_cast<char* const*>(argv.data()));
+      ::execve(argv[0], const_cast<char* const*>(argv.data()), const_cast<char* const*>(envp.data()));
       const char msg[] = "rcfd-server: cannot execute the solver\n";
       (void)!::write(2, msg, sizeof msg - 1);
       ::_exit(127);

@@ -10,6 +10,7 @@
 #include "Ids.hpp"
 #include "PageToken.hpp"
 #include "Target.hpp"
+#include "WorkerPool.hpp"
 
 using namespace rcfd::server;
 
@@ -85,4 +86,16 @@ TEST(ServerPageToken, OnlyTokensTheKeySignedVerify) {
   EXPECT_FALSE(verifyPageToken(token, std::string(key.size(), 'k')));
   EXPECT_FALSE(verifyPageToken("", key));
   std::filesystem::remove_all(dir);
+}
+
+// Solver children share the cores among the workers and wait passively, unless the server's own
+// environment says otherwise; everything else in it passes through unchanged.
+TEST(ServerSolverEnvironment, SharesTheCoresAndWaitsPassivelyUnlessTheServerSetsThem) {
+  const char* plain[] = {"PATH=/usr/bin", "HOME=/var/lib/rcfd", nullptr};
+  EXPECT_EQ(solverEnvironment(2, plain, 8),
+            (std::vector<std::string>{"PATH=/usr/bin", "HOME=/var/lib/rcfd", "OMP_NUM_THREADS=4", "OMP_WAIT_POLICY=passive"}));
+  EXPECT_EQ(solverEnvironment(3, plain, 2)[2], "OMP_NUM_THREADS=1");  // at least one thread each
+  EXPECT_EQ(solverEnvironment(0, plain, 2)[2], "OMP_NUM_THREADS=2");  // no workers: no division by 0
+  const char* set[] = {"OMP_NUM_THREADS=6", "OMP_WAIT_POLICY=active", nullptr};
+  EXPECT_EQ(solverEnvironment(2, set, 8), (std::vector<std::string>{"OMP_NUM_THREADS=6", "OMP_WAIT_POLICY=active"}));
 }
