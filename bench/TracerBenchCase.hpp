@@ -81,6 +81,8 @@ struct TracerBenchCase {
     // The tracer count is an accuracy knob: RCFD_BENCH_TRACERS prices other counts on the same case.
     if (const char* e = std::getenv("RCFD_BENCH_TRACERS")) scene.rcfd.tracers = std::atoll(e);
     scene.rcfd.d0 = 5e-4;
+    // RCFD_BENCH_VELOCITY_INTERPOLATION=mass_weighted prices the mass-weighted u_P^rec on the same case.
+    if (const char* e = std::getenv("RCFD_BENCH_VELOCITY_INTERPOLATION")) scene.rcfd.velocity_interpolation = e;
     Apparatus apparatus(scene.apparatus);
     const CartesianGrid grid = makeGrid(apparatus, scene.grid);
     const auto open = openFractions(apparatus, grid);
