@@ -32,15 +32,13 @@ constexpr auto kProgressWriteInterval = std::chrono::milliseconds(250);  // thro
 
 std::vector<std::string> solverEnvironment(int workers, const char* const* environment, unsigned cores) {
   std::vector<std::string> env;
-  bool threads = false, policy = false;
+  bool threads = false;
   for (const char* const* e = environment; e && *e; ++e) {
     const std::string entry = *e;
     threads = threads || entry.starts_with("OMP_NUM_THREADS=");
-    policy = policy || entry.starts_with("OMP_WAIT_POLICY=");
     env.push_back(entry);
   }
   if (!threads) env.push_back("OMP_NUM_THREADS=" + std::to_string(std::max(1u, cores / unsigned(std::max(1, workers)))));
-  if (!policy) env.push_back("OMP_WAIT_POLICY=passive");
   return env;
 }
 

@@ -23,10 +23,8 @@
 namespace rcfd::server {
 
 /// The environment of a solver child: `environment` (the server's own), plus OMP_NUM_THREADS = the
-/// `cores` shared among `workers` solvers (at least 1 each) and OMP_WAIT_POLICY = passive, each only
-/// where `environment` does not set it. Passive: a solver's thread that waits at a barrier sleeps
-/// instead of spinning, so a solver on cores another process also uses is not slowed many times over
-/// by threads spinning while the one they wait for is descheduled (docs/deploy.md).
+/// `cores` shared among `workers` solvers (at least 1 each) where `environment` does not set it, so
+/// that the server's own solvers never put two spinning OpenMP threads on one core (docs/deploy.md).
 std::vector<std::string> solverEnvironment(int workers, const char* const* environment, unsigned cores);
 /// The same for this process's environment and hardware threads.
 std::vector<std::string> solverEnvironment(int workers);
