@@ -50,6 +50,9 @@ for v in "${variants[@]}"; do
   scene=$(cd "$(dirname "$example")" && cd "$(dirname "$(jq -r '.scene_file' "$example")")" && pwd)/$(basename "$(jq -r '.scene_file' "$example")")
   patch=$(jq '.scene_patch // {}' "$example")
   jq --arg scene "$scene" '.scene_file = $scene' "$example" > "$out/db-$v.json"
+  # The rCFD jobs with the recommended tracer model (docs/calibration.md, "Velocity between cell
+  # centres"): Eq. (10) with the mass-weighted velocity. The database job does not read it.
+  patch=$(jq -n --argjson p "$patch" '$p * {rcfd: {velocity_interpolation: "mass_weighted"}}')
   wants database && run_job "$v database" "$out/db-$v.json" "$out/db-$v"
   [ -f "$out/db-$v/summary.json" ] || continue
 

@@ -185,8 +185,10 @@ constexpr std::int64_t kSteps = 1300, kDiscard = 260;
 
 /// Runs the model on the rotation and checks the stays, the holdup, the walls and the count.
 void expectTheParticlesStaysAndHoldup(const std::vector<std::string>& effects, double d0,
-                                      const SolidBodyRotation& rotation = {}) {
+                                      const SolidBodyRotation& rotation = {},
+                                      const std::string& velocityInterpolation = "trilinear") {
   Scene s = orbitScene(rotation, kTracers, effects, d0);
+  s.rcfd.velocity_interpolation = velocityInterpolation;
   const Outcome o = run(s, orbitDatabase(s, rotation), kSteps, kDiscard);
   const double dt = s.rcfd.dt, window = double(kSteps - kDiscard) * dt;
 
@@ -263,6 +265,12 @@ TEST(OrbitStays, MeanModelWithoutRelaxationCrossesTheBandAsTheParticles) {
 
 TEST(OrbitStays, MeanModelAtASmallD0CrossesTheBandAsTheParticles) {
   expectTheParticlesStaysAndHoldup(kMeanModel, 1e-5);
+}
+
+// The mass-weighted velocity is the trilinear one inside the disk (alpha_P uniform there); at its rim it
+// leans to the disk's side, which must not pull tracers in or out.
+TEST(OrbitStays, MeanModelWithTheMassWeightedVelocityCrossesTheBandAsTheParticles) {
+  expectTheParticlesStaysAndHoldup(kMeanModel, 1e-5, {}, "mass_weighted");
 }
 
 TEST(OrbitStays, LangevinModelCrossesTheBandAsTheParticles) {
