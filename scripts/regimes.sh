@@ -13,7 +13,7 @@
 # Resumable: run it again with the same OUT_DIR and finished jobs are kept, interrupted ones resume
 # from their checkpoints. RCFD_REGIMES_DATABASE_JOB picks the database job variant (default
 # "database"; "database-10s" samples 10 s + 10 s where examples/jobs has it), RCFD_REGIMES_MODELS the
-# models (default "mean streams relax langevin"), RCFD_REGIMES_DEM_PATCH a JSON object merged into the
+# models (default "mean mean-mw streams relax langevin"), RCFD_REGIMES_DEM_PATCH a JSON object merged into the
 # database job's scene_patch.dem (for example '{"frame_alpha_p": "coupling"}'), RCFD_SOLVE the rcfd-solve to run (default
 # build/rcfd-solve; a copy lets a long run go on while the build changes). Needs a build and jq.
 set -euo pipefail
@@ -27,7 +27,7 @@ shift
 regimes=("$@")
 [ ${#regimes[@]} -gt 0 ] || regimes=(quick quick-draft-plates quick-draft-plates-aligned quick-dilute-jet quick-coarse-cells)
 variant=${RCFD_REGIMES_DATABASE_JOB:-database}
-read -r -a models <<< "${RCFD_REGIMES_MODELS:-mean streams relax langevin}"
+read -r -a models <<< "${RCFD_REGIMES_MODELS:-mean mean-mw streams relax langevin}"
 solve=${RCFD_SOLVE:-$(pwd)/build/rcfd-solve}
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 
