@@ -13,6 +13,7 @@
 #include "import/OpenFoamImport.hpp"
 #include "jobs/Cancellation.hpp"
 #include "scene/SceneLoader.hpp"
+#include "tracers/TracerEffect.hpp"
 
 namespace rcfd::cli {
 namespace {
@@ -32,6 +33,7 @@ int run(const Options& o) {
   io.caseDir = o.caseDir;
   io.databasePath = o.out;
   io.cloud = o.cloud;
+  io.velocitySpread = TracerEffectRegistry::needsVelocitySpread(scene.effects);
   if (!o.times.empty()) io.times = openfoam::TimeRange::parse(o.times, "--times");
   installCancellationHandlers();
   io.stopRequested = [] { return cancellationRequested(); };

@@ -65,6 +65,7 @@ void CartesianMapping::beginFrame() {
   gasMomentum_.assign(3 * n, 0.0);
   redirected_ = outside_ = 0;
   received_ = 0.0;
+  received_particles_.clear();
 }
 
 void CartesianMapping::addParticles(const Eigen::Vector3d& at, double volume, const Eigen::Vector3d& velocity) {
@@ -75,6 +76,7 @@ void CartesianMapping::addParticles(const Eigen::Vector3d& at, double volume, co
   particleVolume_[c] += volume;
   received_ += volume;
   for (int d = 0; d < 3; ++d) particleMomentum_[3 * c + std::size_t(d)] += volume * velocity[d];
+  if (spread_) received_particles_.push_back({at, velocity, volume, c});
 }
 
 void CartesianMapping::addGas(const Eigen::Vector3d& at, double volume, const Eigen::Vector3d& velocity) {
@@ -183,7 +185,76 @@ FieldFrame CartesianMapping::finishFrame(MappingCounts& counts) {
     for (std::size_t c : wave) filled[c] = 1;  // a source from the next wave on
     counts.gasFilledCells += std::int64_t(wave.size());
   }
+  if (spread_) addVelocitySpread(f);
   return f;
+}
+
+Eigen::Vector3d CartesianMapping::interpolatedMean(const FieldFrame& f, const Eigen::Vector3d& p,
+                                                   std::size_t cell) const {
+  int lo[3];
+  double fraction[3];
+  for (int d = 0; d < 3; ++d) {
+    const int n = grid_.shape[std::size_t(d)];
+    const double t = std::clamp((p[d] - grid_.origin[d]) / grid_.spacing[d] - 0.5, 0.0, double(n - 1));
+    lo[d] = std::min(int(t), std::max(0, n - 2));
+    fraction[d] = n > 1 ? t - double(lo[d]) : 0.0;
+  }
+  // Weighted by alpha_P as well (the mass-weighted velocity of the tracers, docs/calibration.md): a
+  // corner without particles has no velocity of its own to give.
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double weights = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    int ijk[3];
+    double w = 1.0;
+    for (int d = 0; d < 3; ++d) {
+      const bool upper = (corner >> d) & 1;
+      w *= upper ? fraction[d] : 1.0 - fraction[d];
+      ijk[d] = lo[d] + (upper && grid_.shape[std::size_t(d)] > 1 ? 1 : 0);
+    }
+    if (!(w > 0.0)) continue;
+    const std::size_t c = std::size_t(grid_.flatIndex(ijk[0], ijk[1], ijk[2]));
+    const double a = f.alpha_p[c];
+    if (!(a > 0.0) || fluid_[c] <= 0.0f) continue;
+    sum += w * a * Eigen::Vector3d(f.u_p[3 * c], f.u_p[3 * c + 1], f.u_p[3 * c + 2]);
+    weights += w * a;
+  }
+  if (weights > 0.0) return sum / weights;
+  return {f.u_p[3 * cell], f.u_p[3 * cell + 1], f.u_p[3 * cell + 2]};
+}
+
+void CartesianMapping::addVelocitySpread(FieldFrame& f) const {
+  // As the database job's (coupling::VolumeMapping::velocitySpread()): the share of the particle volume
+  // moving up, the mean velocities of the up- and down-moving parts, and the variance per component
+  // about the mean a tracer at the particle's position moves with (the mean's own variation across a
+  // cell is not a fluctuation).
+  const std::size_t n = f.alpha_p.size();
+  std::vector<double> volume(n, 0.0), upVolume(n, 0.0);
+  std::vector<Eigen::Vector3d> up(n, Eigen::Vector3d::Zero()), down(n, Eigen::Vector3d::Zero()),
+      variance(n, Eigen::Vector3d::Zero());
+  for (const Received& r : received_particles_) {
+    const bool rising = r.velocity.y() > 0.0;
+    volume[r.cell] += r.volume;
+    (rising ? up : down)[r.cell] += r.volume * r.velocity;
+    if (rising) upVolume[r.cell] += r.volume;
+    variance[r.cell] += r.volume * (r.velocity - interpolatedMean(f, r.at, r.cell)).cwiseAbs2();
+  }
+  f.up_fraction.assign(n, 0.0f);
+  f.u_p_up.assign(3 * n, 0.0f);
+  f.u_p_down.assign(3 * n, 0.0f);
+  f.u_p_variance.assign(3 * n, 0.0f);
+  for (std::size_t c = 0; c < n; ++c) {
+    if (!(volume[c] > 0.0)) continue;
+    const double downVolume = volume[c] - upVolume[c];
+    const Eigen::Vector3d mean(f.u_p[3 * c], f.u_p[3 * c + 1], f.u_p[3 * c + 2]);
+    const Eigen::Vector3d u = upVolume[c] > 0.0 ? Eigen::Vector3d(up[c] / upVolume[c]) : mean;
+    const Eigen::Vector3d v = downVolume > 0.0 ? Eigen::Vector3d(down[c] / downVolume) : mean;
+    f.up_fraction[c] = float(std::clamp(upVolume[c] / volume[c], 0.0, 1.0));
+    for (int d = 0; d < 3; ++d) {
+      f.u_p_up[3 * c + std::size_t(d)] = float(u[d]);
+      f.u_p_down[3 * c + std::size_t(d)] = float(v[d]);
+      f.u_p_variance[3 * c + std::size_t(d)] = float(variance[c][d] / volume[c]);
+    }
+  }
 }
 
 }  // namespace rcfd::openfoam

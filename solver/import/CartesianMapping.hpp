@@ -40,12 +40,16 @@ class CartesianMapping {
   /// The open cell that receives what lies at p; `outside` tells whether p was outside the grid box.
   std::int64_t receivingCell(const Eigen::Vector3d& p, bool* redirected = nullptr, bool* outside = nullptr) const;
 
+  /// Record the particles' velocity spread in every frame (FieldFrame::up_fraction, u_p_up, u_p_down,
+  /// u_p_variance), as the database job does for the tracer effects that read it.
+  void recordVelocitySpread(bool on) { spread_ = on; }
+
   /// Starts a new frame (clears the sums).
   void beginFrame();
   void addParticles(const Eigen::Vector3d& at, double volume, const Eigen::Vector3d& velocity);
   void addGas(const Eigen::Vector3d& at, double volume, const Eigen::Vector3d& velocity);
-  /// The frame: alpha_p, u_p, u_g (no velocity spread); rcfd::InputError when the particle volume does
-  /// not fit into the open volume at all.
+  /// The frame: alpha_p, u_p, u_g, and the velocity spread when recorded; rcfd::InputError when the
+  /// particle volume does not fit into the open volume at all.
   FieldFrame finishFrame(MappingCounts& counts);
 
   const CartesianGrid& grid() const { return grid_; }
@@ -53,6 +57,17 @@ class CartesianMapping {
 
  private:
   void redistributeOverfull(MappingCounts& counts);
+  void addVelocitySpread(FieldFrame& f) const;
+  /// u_P of frame f trilinear between the centres of the open cells at p (the mean a tracer there moves
+  /// with), the cell's own where no open neighbour holds particles.
+  Eigen::Vector3d interpolatedMean(const FieldFrame& f, const Eigen::Vector3d& p, std::size_t cell) const;
+  struct Received {
+    Eigen::Vector3d at, velocity;
+    double volume;
+    std::size_t cell;
+  };
+  bool spread_ = false;
+  std::vector<Received> received_particles_;  ///< this frame's particles, when the spread is recorded
   std::vector<std::array<std::int64_t, 6>> neighbours_;  ///< open face neighbours (-1: none)
   CartesianGrid grid_;
   std::vector<float> fluid_;

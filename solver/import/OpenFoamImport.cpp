@@ -152,8 +152,14 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
   result.alphaPMean.assign(std::size_t(grid.cellCount()), 0.0);
   nlohmann::json summary;
   try {
-    FieldDatabaseWriter writer(partial.string(), grid, mapping.fluidFraction(), dtRec, scene.source_json);
     const bool lagrangian = c.particleSource == ParticleSource::Lagrangian;
+    // An Eulerian particle phase has only its mean velocity per cell: no spread to write.
+    const bool spread = options.velocitySpread && lagrangian;
+    mapping.recordVelocitySpread(spread);
+    FieldDatabaseWriterOptions writeOptions;
+    writeOptions.velocitySpread = spread;
+    FieldDatabaseWriter writer(partial.string(), grid, mapping.fluidFraction(), dtRec, scene.source_json,
+                               writeOptions);
     IdentifiedStays stays;
     bool identities = lagrangian, identitiesSeen = false;
     std::string identitiesMissingAt;
@@ -250,6 +256,7 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
                {"dt_rec", dtRec},
                {"fields", {{"gas_velocity", c.gasVelocityField}}},
                {"particle_source", lagrangian ? "lagrangian" : "eulerian"},
+               {"velocity_spread", spread},
                {"particle_volume", {{"first_frame_m3", firstParticleVolume},
                                     {"max_relative_error", worstRelativeError}}},
                {"mapping", {{"max_redirected", worst.redirected},

@@ -23,6 +23,9 @@ struct ImportOptions {
   std::string databasePath;  ///< written through DB.partial and renamed when complete
   TimeRange times;
   std::string cloud;         ///< empty: the case's only cloud
+  /// Write the particles' velocity spread with every frame (a Lagrangian cloud only): what the scene's
+  /// tracer effects read when TracerEffectRegistry::needsVelocitySpread() says so.
+  bool velocitySpread = false;
   /// Polled between frames; true ends the import with rcfd::Cancelled (nothing is kept).
   std::function<bool()> stopRequested = {};
   /// Called after each frame with the fraction of frames done.

@@ -12,6 +12,7 @@
 #include "jobs/Cancellation.hpp"
 #include "jobs/JobRunner.hpp"
 #include "jobs/Progress.hpp"
+#include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
 namespace {
@@ -26,6 +27,7 @@ class ImportJob final : public JobRunner {
     io.cloud = doc.value("cloud", std::string());
     if (doc.contains("times")) io.times = openfoam::TimeRange::parse(doc.at("times").get<std::string>(), "/times");
     io.databasePath = options.outDir + "/database.h5";
+    io.velocitySpread = TracerEffectRegistry::needsVelocitySpread(job.scene.effects);
     ProgressReporter progress(options.progressJson, options.progressInterval, "import ");
     progress.setPhase("import");
     progress.setPhaseFraction(0.0);

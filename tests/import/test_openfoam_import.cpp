@@ -157,10 +157,11 @@ class OpenFoamImport : public testing::Test {
   }
 
   rcfd::openfoam::ImportResult import(const fs::path& root, const std::string& name,
-                                      const std::string& times = "") {
+                                      const std::string& times = "", bool velocitySpread = false) {
     rcfd::openfoam::ImportOptions o;
     o.caseDir = root.string();
     o.databasePath = (dir_ / name).string();
+    o.velocitySpread = velocitySpread;
     if (!times.empty()) o.times = rcfd::openfoam::TimeRange::parse(times, "--times");
     return rcfd::openfoam::importOpenFoam(scene_, o);
   }
@@ -209,6 +210,47 @@ TEST_F(OpenFoamImport, FramesConserveParticleVolumeAndWeightVelocities) {
   EXPECT_NEAR(frame0->alpha_p[cell], (parcelVolume(a) + parcelVolume(f)) / cellVolume, 1e-7);
   EXPECT_LT(result.summary.at("particle_volume").at("max_relative_error").get<double>(), 1e-6);
   EXPECT_EQ(result.summary.at("cloud"), "kinematicCloud");
+}
+
+// Asked for (a scene whose tracer effects read it), a Lagrangian cloud's frames carry the velocity spread
+// the database job writes: the up-moving share of the particle volume and the two parts' mean velocities,
+// which recombine to u_P, and a variance >= 0; the mean fields are those of an import without it.
+TEST_F(OpenFoamImport, TheVelocitySpreadOfACloudIsWrittenWhenAskedAndRecombinesToTheMean) {
+  const fs::path root = writeReconstructed();
+  const auto with = import(root, "spread.h5", "", true);
+  import(root, "plain.h5");
+  EXPECT_TRUE(with.summary.at("velocity_spread").get<bool>());
+  auto spread = rcfd::FieldDatabase::open((dir_ / "spread.h5").string(), rcfd::FrameStorage{0, true});
+  auto plain = rcfd::FieldDatabase::open((dir_ / "plain.h5").string());
+  ASSERT_TRUE(spread->hasVelocitySpread());
+  EXPECT_FALSE(plain->hasVelocitySpread());
+  const auto& g = spread->grid();
+  for (int n = 0; n < spread->frameCount(); ++n) {
+    const auto f = spread->frame(n), q = plain->frame(n);
+    EXPECT_EQ(f->alpha_p, q->alpha_p) << n;
+    EXPECT_EQ(f->u_p, q->u_p) << n;
+    for (std::int64_t c = 0; c < g.cellCount(); ++c) {
+      const std::size_t i = std::size_t(c);
+      if (!(f->alpha_p[i] > 0.0f)) continue;
+      const double share = f->up_fraction[i];
+      EXPECT_GE(share, 0.0);
+      EXPECT_LE(share, 1.0);
+      for (std::size_t d = 0; d < 3; ++d) {
+        EXPECT_NEAR(share * f->u_p_up[3 * i + d] + (1.0 - share) * f->u_p_down[3 * i + d], f->u_p[3 * i + d], 1e-5)
+            << "frame " << n << " cell " << c;
+        EXPECT_GE(f->u_p_variance[3 * i + d], 0.0f);
+      }
+    }
+  }
+  // Frame 0: A and F share grid cell (1, 0, 0); the up share is the volume of those rising.
+  const auto parcels = parcelsAt(0);
+  const TestParcel& a = parcels[0];
+  const TestParcel& b = parcels.back();
+  const double rising = (a.u.y() > 0.0 ? parcelVolume(a) : 0.0) + (b.u.y() > 0.0 ? parcelVolume(b) : 0.0);
+  const std::size_t cell = std::size_t(g.flatIndex(1, 0, 0));
+  EXPECT_NEAR(spread->frame(0)->up_fraction[cell], rising / (parcelVolume(a) + parcelVolume(b)), 1e-6);
+  // Without a cloud's parcels there is no spread to write: an import not asked writes none either.
+  EXPECT_FALSE(import(root, "again.h5").summary.at("velocity_spread").get<bool>());
 }
 
 TEST_F(OpenFoamImport, GasVelocityIsTheVolumeWeightedMeanOverTheCell) {

@@ -224,7 +224,9 @@ TEST_F(EnsembleJob, MembersAreTheJobsOfTheirSeedsAndTheSummaryGivesMeanAndSpread
   for (const auto& [path, bytes] : datasets(plain / "result.h5")) {
     ASSERT_TRUE(root.count(path)) << path;
     EXPECT_EQ(root.at(path), bytes) << path;
-    if (path != "/scene") EXPECT_EQ(root.at("/ensemble/members/00" + path), bytes) << path;
+    if (path != "/scene") {
+      EXPECT_EQ(root.at("/ensemble/members/00" + path), bytes) << path;
+    }
   }
   EXPECT_NE(root.at("/ensemble/members/01/path/frames"), root.at("/path/frames"));
   rcfd::h5::File r((four / "result.h5").string(), rcfd::h5::File::Mode::ReadOnly);

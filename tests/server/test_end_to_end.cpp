@@ -299,6 +299,19 @@ TEST_F(EndToEnd, AKilledSolverIsRetriedFromItsCheckpointAutomaticallyAndOnReques
   EXPECT_EQ(requested, 1) << events.dump(2);
 }
 
+/// Whether `sig` is pending for process `pid` (its own or its thread group's pending set in
+/// /proc/PID/status): a stopped process holds a signal sent to it until it runs again.
+bool signalPending(pid_t pid, int sig) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("SigPnd:", 0) != 0 && line.rfind("ShdPnd:", 0) != 0) continue;
+    const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+    if (mask & (1ULL << (sig - 1))) return true;
+  }
+  return false;
+}
+
 // The job must still be running when the server dies, however fast the machine: once the solver has
 // written its first checkpoint, the test freezes it (SIGSTOP), kills the server, and only then lets it go
 // on (SIGCONT) to meet its PDEATHSIG. Waiting for a progress fraction instead raced the job's end: a
@@ -351,17 +364,36 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
   EXPECT_TRUE(requeued) << events.dump(2);
 }
 
+// As above, the job must still run when the server is told to stop, however fast the machine: the
+// solver is frozen once it has a checkpoint, the server gets SIGTERM, and the solver goes on only when
+// the server's SIGTERM waits for it, so it cannot finish first.
 TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
   std::string id;
   {
     auto server = start(1);
     const std::string db = upload(*server);
     id = submit(*server, sprayJob(db, 12.0, 4));
-    const auto running = pollJob(*server, id, [](const nlohmann::json& j) {
-      return j.at("state") == "RUNNING" && j.at("progress").at("fraction").get<double>() > 0;
-    });
+    const auto checkpoint = tmp_->path() / "data" / "jobs" / id / "checkpoint.h5";
+    pid_t solver = -1;
+    for (int i = 0; i < 6000 && solver < 0; ++i) {
+      const auto solvers = childrenOf(server->pid());
+      if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0)
+        solver = solvers[0];
+      else
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen";
+    const auto running = server->get("/v1/jobs/" + id).json();
+    const bool alive = processRunning(solver);
+    ::kill(server->pid(), SIGTERM);
+    for (int i = 0; i < 2000 && !signalPending(solver, SIGTERM); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    const bool told = signalPending(solver, SIGTERM);
+    ::kill(solver, SIGCONT);  // released before any assertion: no stopped orphan is left behind
+    const int status = server->stop(0);  // waits for the solver to checkpoint and the server to exit
+    ASSERT_TRUE(alive);
+    ASSERT_TRUE(told) << "the server did not pass SIGTERM to its solver";
     ASSERT_EQ(running.at("state"), "RUNNING") << running.dump(2);
-    const int status = server->stop(SIGTERM);  // waits for the solver to checkpoint
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << server->stderrText();
   }
   auto server = start(1);
