@@ -9,8 +9,8 @@
 //   - against the finest setting (most tracers, smallest step): the distribution of droplets per
 //     particle (KS distance, mean, p10, p90) and the overspray, with the finest setting's own seed
 //     spread beside them, so that statistical and systematic error are told apart.
-// Knobs: tracer count, rCFD time step, integrator, tracer motion model, D0, free flight, sub-steps, and
-// the database's sampling rate and length (subsampled copies of the database: every k-th frame, the
+// Knobs: tracer count, rCFD time step, integrator, tracer motion model, velocity interpolation, D0, free
+// flight, sub-steps, and the database's sampling rate and length (subsampled copies of the database: every k-th frame, the
 // first frames), with the frames between two held or blended (rcfd.frame_interpolation). The database's own cost (cell size, coarse graining) is a database job per setting and
 // is not part of this ladder (docs/accuracy.md).
 // Writes OUT/accuracy.json (every run), OUT/accuracy.md (tables), OUT/accuracy-stays.svg and
@@ -362,6 +362,10 @@ json runAccuracy(const Options& options) {
       {{"rcfd", {{"integrator", rcfd.value("integrator", "midpoint") == "euler" ? "midpoint" : "euler"}}}});
   for (const std::string model : {"mean", "relax", "langevin"})
     if (effectsOfModel(effects, model) != effects) add("model", model, {{"effects", effectsOfModel(effects, model)}});
+  // u_P^rec between cell centres: the scene's interpolation against the other one.
+  const std::string interpolation = rcfd.value("velocity_interpolation", "trilinear");
+  const std::string otherInterpolation = interpolation == "mass_weighted" ? "trilinear" : "mass_weighted";
+  add("velocity_interpolation", otherInterpolation, {{"rcfd", {{"velocity_interpolation", otherInterpolation}}}});
   for (double d0 : options.quick ? std::vector<double>{0.0, 1e-3} : std::vector<double>{0.0, 1e-4, 1e-3, 1e-2})
     if (std::fabs(d0 - rcfd.value("d0", 0.0)) > 1e-15) add("d0", formatNumber(d0), {{"rcfd", {{"d0", d0}}}});
   if (withoutEffect(effects, "free_flight") != effects)
