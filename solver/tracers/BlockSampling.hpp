@@ -39,12 +39,12 @@ struct BlockStencils {
 };
 
 /// The combination of the 8 corners (corner c at field + off[c]; bit 0 of c is x, bit 1 y, bit 2 z)
-/// with fractions (fx, fy, fz): linear interpolation along z, then y, then x, each a + f (b - a) as
-/// one fused multiply-add in float. Exact for a uniform field. The scalar reference
-/// of sampleBlock().
-inline void interpolateCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
-                               float out[3]) {
-  for (int d = 0; d < 3; ++d) {
+/// with fractions (fx, fy, fz) for the first `Components` floats of a cell: linear interpolation along
+/// z, then y, then x, each a + f (b - a) as one fused multiply-add in float. Exact for a uniform field.
+template <int Components>
+inline void combineCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
+                           float out[Components]) {
+  for (int d = 0; d < Components; ++d) {
     float t[4];
     for (int j = 0; j < 4; ++j) {
       const float a = field[off[j] + d], b = field[off[j + 4] + d];
@@ -56,21 +56,18 @@ inline void interpolateCorners(const float* field, const std::int32_t* off, floa
   }
 }
 
+/// u at the point: the scalar reference of sampleBlock().
+inline void interpolateCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
+                               float out[3]) {
+  combineCorners<3>(field, off, fx, fy, fz, out);
+}
+
 /// interpolateCorners() of a mass-weighted step field, (w u_x, w u_y, w u_z, w) per cell: the four
 /// components combined alike, then the momentum divided by the weight (StepVelocityField::build()).
 inline void interpolateWeightedCorners(const float* field, const std::int32_t* off, float fx, float fy, float fz,
                                        float out[3]) {
   float v[4];
-  for (int d = 0; d < 4; ++d) {
-    float t[4];
-    for (int j = 0; j < 4; ++j) {
-      const float a = field[off[j] + d], b = field[off[j + 4] + d];
-      t[j] = std::fma(fz, b - a, a);
-    }
-    const float s0 = std::fma(fy, t[2] - t[0], t[0]);
-    const float s1 = std::fma(fy, t[3] - t[1], t[1]);
-    v[d] = std::fma(fx, s1 - s0, s0);
-  }
+  combineCorners<4>(field, off, fx, fy, fz, v);
   for (int d = 0; d < 3; ++d) out[d] = v[d] / v[3];
 }
 

@@ -299,6 +299,17 @@ TEST_F(EndToEnd, AKilledSolverIsRetriedFromItsCheckpointAutomaticallyAndOnReques
   EXPECT_EQ(requested, 1) << events.dump(2);
 }
 
+/// The server's one solver, stopped (SIGSTOP) once `checkpoint` exists; -1 when none is seen within 30 s.
+pid_t freezeSolverAtItsCheckpoint(pid_t server, const std::filesystem::path& checkpoint) {
+  for (int i = 0; i < 6000; ++i) {
+    const auto solvers = childrenOf(server);
+    if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0)
+      return solvers[0];
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return -1;
+}
+
 /// Whether `sig` is pending for process `pid` (its own or its thread group's pending set in
 /// /proc/PID/status): a stopped process holds a signal sent to it until it runs again.
 bool signalPending(pid_t pid, int sig) {
@@ -323,14 +334,7 @@ TEST_F(EndToEnd, ServerKilledMidJobResumesToTheSameResult) {
     auto server = start(1);
     db = upload(*server);
     interrupted = submit(*server, sprayJob(db, 12.0, 5));
-    const auto checkpoint = tmp_->path() / "data" / "jobs" / interrupted / "checkpoint.h5";
-    for (int i = 0; i < 6000 && solver < 0; ++i) {
-      const auto solvers = childrenOf(server->pid());
-      if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0)
-        solver = solvers[0];
-      else
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    solver = freezeSolverAtItsCheckpoint(server->pid(), tmp_->path() / "data" / "jobs" / interrupted / "checkpoint.h5");
     ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen";
     const auto frozen = server->get("/v1/jobs/" + interrupted).json();
     const bool alive = processRunning(solver);  // not a zombie that finished before the SIGSTOP
@@ -373,15 +377,7 @@ TEST_F(EndToEnd, SigtermRequeuesTheRunningJobAndTheNextStartFinishesIt) {
     auto server = start(1);
     const std::string db = upload(*server);
     id = submit(*server, sprayJob(db, 12.0, 4));
-    const auto checkpoint = tmp_->path() / "data" / "jobs" / id / "checkpoint.h5";
-    pid_t solver = -1;
-    for (int i = 0; i < 6000 && solver < 0; ++i) {
-      const auto solvers = childrenOf(server->pid());
-      if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0)
-        solver = solvers[0];
-      else
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    const pid_t solver = freezeSolverAtItsCheckpoint(server->pid(), tmp_->path() / "data" / "jobs" / id / "checkpoint.h5");
     ASSERT_GT(solver, 0) << "no solver with a checkpoint was seen";
     const auto running = server->get("/v1/jobs/" + id).json();
     const bool alive = processRunning(solver);
