@@ -40,12 +40,13 @@ class StepVelocityField {
     const FieldFrame* next = sampler.nextFrame();
     frameValues_ = nullptr;
     weighted_ = false;
-    if (!next && layout == StepFieldLayout::Any) {
-      frameValues_ = fa.data();
-      return;
-    }
+    // A mass-weighted u_P has no frame array to refer to: it is built padded whatever the layout asked.
     if (massWeight > 0.0f && !useGas) {
       buildWeighted(sampler, parallel, massWeight);
+      return;
+    }
+    if (!next && layout == StepFieldLayout::Any) {
+      frameValues_ = fa.data();
       return;
     }
     const float* fb = next ? (useGas ? next->u_g : next->u_p).data() : nullptr;
