@@ -159,6 +159,9 @@ lines = [
     ("particle volume error (max rel.)", "%.2g %s" % (vol_err, "(ok: <= 1e-6)" if vol_err <= 1e-6 else "(FAILS: > 1e-6)")),
     ("spout: alpha_P jet / annulus", "%.3f / %.3f (10-40 mm; jet below 0.3 in %.0f %% of frames), fountain %.3f"
      % (jet.mean(), ann.mean(), 100 * (jet < 0.3).mean(), fountain)),
+    ("bed pressure drop (from p)", "mean %s Pa, std %s Pa, dominant frequency %s Hz"
+     % (f((ref.get("pressure_drop") or {}).get("mean_pa"), "%.1f"), f((ref.get("pressure_drop") or {}).get("std_pa"), "%.1f"),
+        f((ref.get("pressure_drop") or {}).get("dominant_frequency_hz"), "%.2f"))),
     ("reference holdup", "%s particles (%s parcels)" % (f(ref["holdup"]["mean"], "%.1f"), f(ref["holdup"].get("mean_parcels"), "%.1f"))),
     ("reference stays", "%s completed, %s censored, mean %s s, %s parcels seen"
      % (rt.get("stays"), rt.get("censored"), f(rt.get("mean_s"), "%.4f"), rt.get("members"))),

@@ -188,6 +188,24 @@ nlohmann::json ReferenceRecorder::periodsSummary() const {
             std::string("database.h5:") + analysis::reference_layout::sampledHoldup}}};
 }
 
+nlohmann::json pressureDropSummary(const std::vector<double>& pa, double dt) {
+  nlohmann::json dp = {{"samples", pa.size()}, {"dt_s", dt},
+                       {"series_file", std::string("database.h5:") + reference_series::pressureDrop}};
+  constexpr std::size_t kSpectrumSamples = 4;
+  if (pa.size() >= kSpectrumSamples) {
+    const auto s = analysis::seriesSpectrum(pa, dt);
+    dp["mean_pa"] = s.mean;
+    dp["std_pa"] = s.std;
+    dp["dominant_frequency_hz"] = s.dominantFrequency ? nlohmann::json(*s.dominantFrequency) : nlohmann::json();
+    dp["frequency_resolution_hz"] = s.resolution;
+  } else {
+    dp["mean_pa"] = nullptr;
+    dp["std_pa"] = nullptr;
+    dp["dominant_frequency_hz"] = nullptr;
+  }
+  return dp;
+}
+
 nlohmann::json ReferenceRecorder::summary(double dtRec, int residenceTimeBins) const {
   nlohmann::json out;
   nlohmann::json rt = stays_.statistics(dt_, residenceTimeBins).toJson();
@@ -203,21 +221,7 @@ nlohmann::json ReferenceRecorder::summary(double dtRec, int residenceTimeBins) c
                    {"mean_fraction", stays_.members() ? mean / double(stays_.members()) : 0.0},
                    {"series_file", std::string("database.h5:") + analysis::reference_layout::holdup}};
 
-  nlohmann::json dp = {{"samples", samples()}, {"dt_s", dt_},
-                       {"series_file", std::string("database.h5:") + reference_series::pressureDrop}};
-  constexpr std::int64_t kSpectrumSamples = 4;
-  if (samples() >= kSpectrumSamples) {
-    const auto s = analysis::seriesSpectrum(pressureDrop_, dt_);
-    dp["mean_pa"] = s.mean;
-    dp["std_pa"] = s.std;
-    dp["dominant_frequency_hz"] = s.dominantFrequency ? nlohmann::json(*s.dominantFrequency) : nlohmann::json();
-    dp["frequency_resolution_hz"] = s.resolution;
-  } else {
-    dp["mean_pa"] = nullptr;
-    dp["std_pa"] = nullptr;
-    dp["dominant_frequency_hz"] = nullptr;
-  }
-  out["pressure_drop"] = dp;
+  out["pressure_drop"] = pressureDropSummary(pressureDrop_, dt_);
   out["periods"] = periodsSummary();
 
   // Eq. (8) from each probe's u_P,y over the sampled period, sampled every dt_ < dt_rec.

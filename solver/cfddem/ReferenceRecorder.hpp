@@ -38,6 +38,11 @@ inline constexpr const char* pressureDrop = "/reference/pressure_drop/pa";    //
 inline constexpr const char* holdupParcels = "/reference/holdup/parcels";     ///< float64 [R]
 }  // namespace reference_series
 
+/// summary.json's "pressure_drop" of a series sampled every `dt` [s] (stored at
+/// reference_series::pressureDrop): samples, mean and standard deviation [Pa], the dominant frequency
+/// and its resolution [Hz]; the statistics null below 4 samples.
+nlohmann::json pressureDropSummary(const std::vector<double>& pa, double dt);
+
 class ReferenceRecorder {
  public:
   /// parcels: number of DEM parcels (ids 0 .. parcels-1); dt: sampling interval [s]; referenceStart:

@@ -151,6 +151,7 @@ OpenFoamCase OpenFoamCase::open(const fs::path& root, const TimeRange& range, co
   c.gasVelocityField = firstPresent(first, kGasVelocityNames);
   if (c.gasVelocityField.empty())
     throw InputError(first.string(), "gas velocity", "no gas velocity field: expected one of " + joined(kGasVelocityNames));
+  c.pressureField = firstPresent(first, kPressureNames);
   if (c.cloud.empty()) {
     c.particleFractionField = firstPresent(first, kParticleFractionNames);
     c.particleSource = ParticleSource::EulerianFraction;

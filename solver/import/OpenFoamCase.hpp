@@ -40,6 +40,7 @@ struct OpenFoamCase {
   std::string gasVelocityField;              ///< e.g. U.air
   std::string particleFractionField;         ///< Eulerian: alpha.particles or voidfraction
   std::string particleVelocityField;         ///< Eulerian: U.particles or Us
+  std::string pressureField;                 ///< the gas pressure, p (empty: the case writes none)
 
   /// Finds parts, times, cloud and fields. `cloudName` picks one of several clouds (empty: the only
   /// one). rcfd::InputError naming the directory or file when the case has no mesh, no selected time,
@@ -55,6 +56,7 @@ inline const std::vector<std::string> kGasVelocityNames = {"U.air", "U.gas", "U.
 inline const std::vector<std::string> kParticleFractionNames = {"alpha.particles", "alpha.solid", "alpha.solids",
                                                                 "alpha.particle"};
 inline const std::vector<std::string> kVoidFractionNames = {"voidfraction"};
+inline const std::vector<std::string> kPressureNames = {"p"};
 inline const std::vector<std::string> kParticleVelocityNames = {"U.particles", "U.solid", "U.solids", "U.particle",
                                                                 "Us"};
 

@@ -9,8 +9,9 @@
 namespace rcfd::openfoam {
 namespace fs = std::filesystem;
 
-std::vector<double> readInternalField(const fs::path& file, int components, std::int64_t cellCount) {
-  FoamFile f = FoamFile::read(file);
+namespace {
+
+std::vector<double> internalField(FoamFile& f, int components, std::int64_t cellCount) {
   const std::string what = "internalField";
   if (!f.seekKeyword(what)) f.fail(what, "no internalField entry");
   const std::string kind = f.word(what);
@@ -39,6 +40,30 @@ std::vector<double> readInternalField(const fs::path& file, int components, std:
   }
   if (f.peek() != ';') f.fail(what, "expected ';' after the internalField value");
   return values;
+}
+
+}  // namespace
+
+std::vector<double> readInternalField(const fs::path& file, int components, std::int64_t cellCount) {
+  FoamFile f = FoamFile::read(file);
+  return internalField(f, components, cellCount);
+}
+
+std::vector<double> readInternalField(const fs::path& file, int components, std::int64_t cellCount,
+                                      Dimensions& dimensions) {
+  FoamFile f = FoamFile::read(file);
+  const std::string what = "dimensions";
+  if (!f.seekKeyword(what)) f.fail(what, "no dimensions entry");
+  f.expect('[', what);
+  dimensions.fill(0.0);
+  std::size_t given = 0;
+  while (f.peek() != ']') {
+    if (given == dimensions.size()) f.fail(what, "more than 7 exponents");
+    dimensions[given++] = f.scalar(what);
+  }
+  f.expect(']', what);
+  if (given != 5 && given != 7) f.fail(what, std::to_string(given) + " exponents: expected 5 or 7");
+  return internalField(f, components, cellCount);
 }
 
 namespace {

@@ -4,6 +4,7 @@
 /// per-parcel files of a Lagrangian cloud (lagrangian/<cloud>/positions, U, d, nParticle, origId,
 /// origProcId). ASCII or binary, plain or .gz (FoamFile.hpp).
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -15,6 +16,13 @@ namespace rcfd::openfoam {
 /// `uniform` value repeated over `cellCount` cells or a `nonuniform List<...>` of exactly `cellCount`
 /// items. rcfd::InputError naming the file and `internalField` otherwise.
 std::vector<double> readInternalField(const std::filesystem::path& file, int components, std::int64_t cellCount);
+
+/// SI exponents of a field's `dimensions` entry: [kg m s K mol A cd].
+using Dimensions = std::array<double, 7>;
+
+/// The same with the file's `dimensions` entry (5 or 7 exponents; the missing ones 0) in `dimensions`.
+std::vector<double> readInternalField(const std::filesystem::path& file, int components, std::int64_t cellCount,
+                                      Dimensions& dimensions);
 
 /// The parcels of one cloud at one time, in file order.
 struct CloudParcels {

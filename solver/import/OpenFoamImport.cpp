@@ -1,10 +1,12 @@
 #include "import/OpenFoamImport.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <numbers>
+#include <optional>
 
 #include "analysis/ReferenceStatistics.hpp"
 #include "cfddem/ReferenceRecorder.hpp"
@@ -13,7 +15,9 @@
 #include "fields/FieldDatabase.hpp"
 #include "geometry/Apparatus.hpp"
 #include "geometry/SprayZone.hpp"
+#include "geometry/XdmfGrid.hpp"
 #include "import/CartesianMapping.hpp"
+#include "import/FoamFile.hpp"
 #include "import/OpenFoamFieldReader.hpp"
 #include "import/OpenFoamMesh.hpp"
 
@@ -78,6 +82,81 @@ class IdentifiedStays {
   std::map<std::pair<std::int64_t, std::int64_t>, Member> members_;
   std::vector<std::int64_t> durations_;
 };
+
+/// The bed pressure drop from the gas pressure `p`, as the database job reports it (the pressure where
+/// the gas enters less where it leaves, without the gas's own hydrostatic head): the volume-weighted
+/// mean pressure of the mesh cells in the grid's lowest row of cells less that of its highest row, less
+/// rho_G g times the height between the two rows' mean centres. The rows rather than the inlet and
+/// outlet patches: a zeroGradient patch writes no value, and the rows exist in every case that fits the
+/// scene's grid. A kinematic p ([0 2 -2 0 0 0 0], what incompressible solvers such as MPPICFoam and
+/// DPMFoam write) is multiplied by the scene's gas density; a p in Pa ([1 -1 -2 0 0 0 0]) is taken as
+/// it is.
+class RowPressureDrop {
+ public:
+  RowPressureDrop(const CartesianGrid& grid, const std::vector<CellGeometry>& meshes) : rows_(meshes.size()) {
+    const double bottomTop = grid.origin.y() + grid.spacing.y();
+    const double topBottom = grid.upperCorner().y() - grid.spacing.y();
+    std::array<double, 2> heightSum{};
+    for (std::size_t p = 0; p < meshes.size(); ++p)
+      for (std::int64_t k = 0; k < meshes[p].cellCount(); ++k) {
+        const double y = meshes[p].centres[std::size_t(k)].y(), v = meshes[p].volumes[std::size_t(k)];
+        const int row = y < bottomTop ? 0 : y >= topBottom ? 1 : -1;
+        if (row < 0) continue;
+        rows_[p].push_back({k, row, v});
+        volume_[std::size_t(row)] += v;
+        heightSum[std::size_t(row)] += v * y;
+      }
+    if (usable()) rise_ = heightSum[1] / volume_[1] - heightSum[0] / volume_[0];
+  }
+
+  /// Both rows hold mesh cells (a grid one cell high has no second row).
+  bool usable() const { return volume_[0] > 0.0 && volume_[1] > 0.0; }
+
+  void beginFrame() { sum_ = {}; }
+  /// The pressure of part p's cells (one value per cell).
+  void add(std::size_t part, const std::vector<double>& pressure) {
+    for (const RowCell& c : rows_[part]) sum_[std::size_t(c.row)] += c.volume * pressure[std::size_t(c.cell)];
+  }
+  /// [Pa]: `pressureScale` turns p into Pa; `gasWeight` is rho_G g [Pa/m].
+  double finishFrame(double pressureScale, double gasWeight) const {
+    return pressureScale * (sum_[0] / volume_[0] - sum_[1] / volume_[1]) - gasWeight * rise_;
+  }
+
+ private:
+  struct RowCell {
+    std::int64_t cell;
+    int row;  ///< 0 lowest, 1 highest
+    double volume;
+  };
+  std::vector<std::vector<RowCell>> rows_;  ///< per part
+  std::array<double, 2> volume_{}, sum_{};
+  double rise_ = 0.0;  ///< height of the top row's mean centre above the bottom row's [m]
+};
+
+/// Whether p is kinematic (true) or in Pa (false), from its dimensions; InputError naming the file
+/// otherwise.
+bool kinematicPressure(const Dimensions& d, const fs::path& file) {
+  const Dimensions kinematic{0, 2, -2, 0, 0, 0, 0}, pascal{1, -1, -2, 0, 0, 0, 0};
+  if (d == kinematic) return true;
+  if (d == pascal) return false;
+  std::string text;
+  for (double e : d) text += (text.empty() ? "" : " ") + std::to_string(int(e));
+  throw InputError(file.string(), "dimensions",
+                   "[" + text + "]: a pressure is kinematic [0 2 -2 0 0 0 0] (m2/s2) or in Pa [1 -1 -2 0 0 0 0]");
+}
+
+/// The gravity of the case, constant/g's value (0, -9.81, 0 when the case has none) [m/s2].
+Eigen::Vector3d caseGravity(const fs::path& root) {
+  const auto file = FoamFile::locate(root / "constant/g");
+  if (!file) return {0.0, -9.81, 0.0};
+  FoamFile f = FoamFile::read(*file);
+  if (!f.seekKeyword("value")) f.fail("value", "no value entry");
+  f.expect('(', "value");
+  Eigen::Vector3d g;
+  for (int c = 0; c < 3; ++c) g[c] = f.scalar("value");
+  f.expect(')', "value");
+  return g;
+}
 
 double evenSpacing(const std::vector<WrittenTime>& times, const fs::path& where) {
   const std::size_t n = times.size();
@@ -144,6 +223,11 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
                          "OpenFOAM's transformPoints moves a mesh)");
   }
 
+  RowPressureDrop pressureDrop(grid, meshes);
+  const bool withPressure = !c.pressureField.empty() && pressureDrop.usable();
+  const Eigen::Vector3d gravity = caseGravity(c.root);
+  const double gasWeight = scene.gas.density * std::max(0.0, -gravity.y());
+
   const fs::path finalPath = options.databasePath;
   const fs::path partial = finalPath.string() + ".partial";
   removeQuietly(partial);
@@ -160,6 +244,8 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
     writeOptions.velocitySpread = spread;
     FieldDatabaseWriter writer(partial.string(), grid, mapping.fluidFraction(), dtRec, scene.source_json,
                                writeOptions);
+    std::vector<double> pressureDropPa;
+    std::optional<bool> kinematic;  // p's units, from the first time read
     IdentifiedStays stays;
     bool identities = lagrangian, identitiesSeen = false;
     std::string identitiesMissingAt;
@@ -173,6 +259,7 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
                         " frames; the partial database was removed");
       const WrittenTime& t = c.times[n];
       mapping.beginFrame();
+      pressureDrop.beginFrame();
       std::int64_t parcels = 0;
       double inParcels = 0.0, inParticles = 0.0;
       for (std::size_t p = 0; p < c.parts.size(); ++p) {
@@ -181,6 +268,14 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
         const std::vector<double> ug = readInternalField(dir / c.gasVelocityField, 3, mesh.cellCount());
         for (std::int64_t k = 0; k < mesh.cellCount(); ++k)
           mapping.addGas(mesh.centres[std::size_t(k)], mesh.volumes[std::size_t(k)], at(ug, std::size_t(k)));
+        if (withPressure) {
+          Dimensions dims;
+          const fs::path file = dir / c.pressureField;
+          pressureDrop.add(p, readInternalField(file, 1, mesh.cellCount(), dims));
+          if (kinematic && *kinematic != kinematicPressure(dims, file))
+            throw InputError(file.string(), "dimensions", "differ from those of the first time's " + c.pressureField);
+          kinematic = kinematicPressure(dims, file);
+        }
         if (!lagrangian) {
           const std::vector<double> alpha = readInternalField(dir / c.particleFractionField, 1, mesh.cellCount());
           const std::vector<double> up = readInternalField(dir / c.particleVelocityField, 3, mesh.cellCount());
@@ -239,6 +334,7 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
       worst.gasFilledCells = std::max(worst.gasFilledCells, counts.gasFilledCells);
       parcelsMin = parcelsMin < 0 ? parcels : std::min(parcelsMin, parcels);
       parcelsMax = std::max(parcelsMax, parcels);
+      if (withPressure) pressureDropPa.push_back(pressureDrop.finishFrame(*kinematic ? scene.gas.density : 1.0, gasWeight));
       holdupParcels.push_back(inParcels);
       holdupParticles.push_back(inParticles);
       if (options.progress) options.progress(double(n + 1) / double(frames));
@@ -318,7 +414,22 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
       db.setAttribute("/reference", "reference_t0", 0.0);
       db.flush();
     } else {
-      reference["missing"] = "an Eulerian particle phase has no parcels to follow: no /reference/";
+      reference["missing"] = "an Eulerian particle phase has no parcels to follow: no holdup and no stays";
+    }
+    if (withPressure) {
+      h5::File db(partial.string(), h5::File::Mode::ReadWrite);
+      db.write(reference_series::pressureDrop, pressureDropPa);
+      db.setAttribute(reference_series::pressureDrop, "dt", dtRec);
+      db.setAttribute(reference_series::pressureDrop, "t0", 0.0);
+      db.flush();
+      reference["pressure_drop"] = pressureDropSummary(pressureDropPa, dtRec);
+      reference["pressure_drop"]["field"] = c.pressureField;
+      reference["pressure_drop"]["kinematic"] = *kinematic;
+    } else {
+      reference["pressure_drop"] = nullptr;
+      reference["pressure_drop_missing"] =
+          c.pressureField.empty() ? "the case writes no " + kPressureNames.front() + ": no pressure drop"
+                                  : std::string("the grid is one cell high: no pressure drop between its rows");
     }
     summary["reference"] = reference;
   } catch (...) {
@@ -328,6 +439,7 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
   std::error_code ec;
   fs::rename(partial, finalPath, ec);
   if (ec) throw RunError("cannot rename " + partial.string() + " to " + finalPath.string() + ": " + ec.message());
+  xdmf::writeSidecar(finalPath.string(), xdmfGrid(grid), {}, xdmf::FrameSeries{"/frames", std::int64_t(frames), dtRec});
   summary["database"] = finalPath.string();
   result.summary = std::move(summary);
   return result;

@@ -50,9 +50,6 @@ namespace fs = std::filesystem;
 /// Checkpoint group of the reference coverage's state.
 constexpr const char* kCoverageGroup = "/reference_coverage";
 
-/// Frame cache when the figures read the database back: a few frames of the largest grids.
-constexpr std::int64_t kFigureCacheBytes = 256LL << 20;
-
 /// The scene's effects that belong to the CFD-DEM stage (x-stage "cfd_dem" in the schema).
 std::vector<std::string> cfdDemEffects(const Scene& scene) {
   const auto schema = nlohmann::json::parse(schemaText("scene"));

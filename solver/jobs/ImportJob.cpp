@@ -6,11 +6,15 @@
 
 #include <filesystem>
 
+#include "analysis/DatabaseFigures.hpp"
+#include "cfddem/ReferenceRecorder.hpp"
 #include "core/Errors.hpp"
 #include "core/Hdf5.hpp"
+#include "fields/FieldDatabase.hpp"
 #include "import/OpenFoamImport.hpp"
 #include "jobs/Cancellation.hpp"
 #include "jobs/JobRunner.hpp"
+#include "jobs/JobSupport.hpp"
 #include "jobs/Progress.hpp"
 #include "tracers/TracerEffect.hpp"
 
@@ -49,8 +53,23 @@ class ImportJob final : public JobRunner {
       out.flush();
     }
     fs::rename(options.outDir + "/result.h5.tmp", options.outDir + "/result.h5");
+    xdmf::writeSidecar(options.outDir + "/result.h5", xdmfGrid(g));
     nlohmann::json summary = {{"kind", "import"}, {"status", "succeeded"}};
     summary.update(r.summary);
+    if (job.scene.outputs.svg) {
+      progress.setPhase("figures");
+      analysis::PressureDropSeries dp;
+      const nlohmann::json& p = r.summary["reference"]["pressure_drop"];
+      if (p.is_object()) {
+        h5::File db(io.databasePath, h5::File::Mode::ReadOnly);
+        dp.pa = db.readDoubles(reference_series::pressureDrop);
+        dp.dt = p.at("dt_s").get<double>();
+        if (p.at("dominant_frequency_hz").is_number()) dp.dominantFrequency = p.at("dominant_frequency_hz").get<double>();
+      }
+      const auto db = FieldDatabase::open(io.databasePath, FrameStorage{kFigureCacheBytes});
+      summary["figures"] =
+          analysis::writeDatabaseFigures(job.scene, *db, dp, options.outDir, [] { return cancellationRequested(); });
+    }
     summary["database"] = "database.h5";  // inside DIR, as the database job names it
     summary["wall_time_s"] = progress.wallTime();
     progress.report(1.0, 0.0, true);

@@ -3,13 +3,13 @@
 /// Small helpers the job runners share: the OpenMP thread count of the calling thread, reading a
 /// JSON file a job wrote earlier (summaries, resume keys) and the grid of the XDMF sidecars.
 
+#include <cstdint>
 #include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include "core/Xdmf.hpp"
-#include "geometry/CartesianGrid.hpp"
+#include "geometry/XdmfGrid.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -27,20 +27,12 @@ inline void setRunThreads(int n) {
 #endif
 }
 
+/// Frame cache when a job's figures read a database back: a few frames of the largest grids.
+inline constexpr std::int64_t kFigureCacheBytes = 256LL << 20;
+
 inline nlohmann::json readJsonFile(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
-}
-
-/// `grid` as the XDMF writer takes it (core knows no CartesianGrid).
-inline xdmf::CellGrid xdmfGrid(const CartesianGrid& grid) {
-  xdmf::CellGrid g;
-  for (int d = 0; d < 3; ++d) {
-    g.origin[std::size_t(d)] = grid.origin[d];
-    g.spacing[std::size_t(d)] = grid.spacing[d];
-    g.shape[std::size_t(d)] = grid.shape[std::size_t(d)];
-  }
-  return g;
 }
 
 }  // namespace rcfd

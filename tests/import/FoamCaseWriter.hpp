@@ -201,10 +201,12 @@ inline void writeVolVectorField(const std::filesystem::path& file, const std::ve
                     ";\n\nboundaryField\n{\n    walls\n    {\n        type            noSlip;\n    }\n}\n",
                 style.gzip);
 }
-inline void writeVolScalarField(const std::filesystem::path& file, const std::vector<double>& values, FileStyle style) {
+/// `dimensions` is the field's entry, e.g. "[0 2 -2 0 0 0 0]" for a kinematic pressure.
+inline void writeVolScalarField(const std::filesystem::path& file, const std::vector<double>& values, FileStyle style,
+                                const std::string& dimensions = "[0 0 0 0 0 0 0]") {
   const std::string name = file.filename().string();
   writeFoamFile(file,
-                foamHeader("volScalarField", name, style.encoding) + "dimensions      [0 0 0 0 0 0 0];\n\n" +
+                foamHeader("volScalarField", name, style.encoding) + "dimensions      " + dimensions + ";\n\n" +
                     "internalField   nonuniform List<scalar> " + scalarBody(values, style.encoding) +
                     ";\n\nboundaryField\n{\n    walls\n    {\n        type            zeroGradient;\n    }\n}\n",
                 style.gzip);

@@ -106,6 +106,21 @@ std::vector<Eigen::Vector3d> cellVelocities(const LatticeMesh& m) {
   return u;
 }
 
+/// The gas pressure at written time n: linear in y (so a row's volume mean is its value at the row's
+/// centre: 0.005 m for the lowest row, 0.035 m for the highest), odd in x (the rows' means lose it),
+/// `gradient(n)` per metre of height. Kinematic [m2/s2] in the reconstructed case, Pa in the decomposed.
+double pressureGradient(int n, bool pascal) { return pascal ? 5000.0 + 200.0 * n : 1000.0 + 100.0 * n; }
+double pressureAt(const Eigen::Vector3d& c, int n, bool pascal) {
+  return (pascal ? 1e5 : 50.0) + 10.0 * n - pressureGradient(n, pascal) * c.y() + 3.0 * c.x();
+}
+std::vector<double> cellPressures(const LatticeMesh& m, int n, bool pascal) {
+  std::vector<double> p;
+  for (const auto& c : m.cells()) p.push_back(pressureAt(m.centre(c), n, pascal));
+  return p;
+}
+/// The reconstructed case's gravity (constant/g); the decomposed case has none (9.81 m/s2 is taken).
+constexpr double kCaseGravity = 9.5;
+
 class OpenFoamImport : public testing::Test {
  protected:
   void SetUp() override {
@@ -130,7 +145,14 @@ class OpenFoamImport : public testing::Test {
       const fs::path t = root / kTimes[n];
       rcfd::test::writeVolVectorField(t / "U.air", cellVelocities(m), {Encoding::Ascii, n % 2 == 1});
       rcfd::test::writeCloud(t / "lagrangian/kinematicCloud", parcelsAt(int(n)), {Encoding::Ascii, n == 2}, identities);
+      rcfd::test::writeVolScalarField(t / "p", cellPressures(m, int(n), false), {Encoding::Ascii, n == 3},
+                                      "[0 2 -2 0 0 0 0]");
     }
+    rcfd::test::writeFoamFile(root / "constant/g",
+                              rcfd::test::foamHeader("uniformDimensionedVectorField", "g", Encoding::Ascii) +
+                                  "dimensions      [0 1 -2 0 0 0 0];\nvalue           (0 -" + std::to_string(kCaseGravity) +
+                                  " 0);\n",
+                              false);
     return root;
   }
 
@@ -146,6 +168,8 @@ class OpenFoamImport : public testing::Test {
       for (std::size_t n = 0; n < kTimes.size(); ++n) {
         const fs::path t = proc / kTimes[n];
         rcfd::test::writeVolVectorField(t / "U.air", cellVelocities(m), {Encoding::Binary, false});
+        rcfd::test::writeVolScalarField(t / "p", cellPressures(m, int(n), true), {Encoding::Binary, p == 0},
+                                        "[1 -1 -2 0 0 0 0]");
         std::vector<TestParcel> mine;
         for (const auto& parcel : parcelsAt(int(n)))
           if ((parcel.x.x() < 0.0) == (p == 0)) mine.push_back(parcel);
@@ -297,6 +321,56 @@ TEST_F(OpenFoamImport, ReferenceHoldsTheSprayZoneStaysAndHoldupAsConstructed) {
   EXPECT_EQ(result.summary.at("reference").at("residence_time").at("censored"), 2);  // B and D inside at the end
 }
 
+// The bed pressure drop of the database job: the lowest row's pressure less the highest row's, less
+// the gas's head between the rows' centres (0.03 m apart); a kinematic p times the scene's gas density.
+TEST_F(OpenFoamImport, PressureDropIsTheRowsDifferenceLessTheGasHead) {
+  const double rho = scene_.gas.density, rise = 0.03;
+  for (const bool pascal : {false, true}) {
+    SCOPED_TRACE(pascal ? "decomposed, p in Pa, no constant/g" : "reconstructed, kinematic p, constant/g");
+    const fs::path root = pascal ? writeDecomposed() : writeReconstructed();
+    const auto r = import(root, pascal ? "pa.h5" : "kinematic.h5");
+    const json& dp = r.summary.at("reference").at("pressure_drop");
+    ASSERT_TRUE(dp.is_object()) << r.summary.dump(2);
+    EXPECT_EQ(dp.at("field"), "p");
+    EXPECT_EQ(dp.at("kinematic"), !pascal);
+    EXPECT_EQ(dp.at("samples"), kTimes.size());
+    rcfd::h5::File db((dir_ / (pascal ? "pa.h5" : "kinematic.h5")).string(), rcfd::h5::File::Mode::ReadOnly);
+    const std::vector<double> series = db.readDoubles(rcfd::reference_series::pressureDrop);
+    ASSERT_EQ(series.size(), kTimes.size());
+    double mean = 0.0;
+    for (std::size_t n = 0; n < series.size(); ++n) {
+      const double g = pascal ? 9.81 : kCaseGravity;
+      const double expected = (pascal ? 1.0 : rho) * pressureGradient(int(n), pascal) * rise - rho * g * rise;
+      EXPECT_NEAR(series[n], expected, 1e-9 * std::abs(expected) + 1e-9) << "frame " << n;
+      mean += expected / double(series.size());
+    }
+    EXPECT_NEAR(dp.at("mean_pa").get<double>(), mean, 1e-9 * std::abs(mean));
+    EXPECT_DOUBLE_EQ(db.doubleAttribute(rcfd::reference_series::pressureDrop, "dt"), 0.1);
+  }
+}
+
+TEST_F(OpenFoamImport, APressureInOtherUnitsIsRefusedNamingItsDimensions) {
+  const fs::path root = writeReconstructed();
+  const LatticeMesh m = latticeMesh();
+  rcfd::test::writeVolScalarField(root / "0.3/p", cellPressures(m, 2, false), {Encoding::Ascii, false}, "[0 1 -2 0 0]");
+  try {
+    import(root, "units.h5", "0.1:0.3");
+    ADD_FAILURE() << "a pressure in m/s2 was accepted";
+  } catch (const rcfd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("0.3/p"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dimensions"), std::string::npos) << e.what();
+  }
+  rcfd::test::writeVolScalarField(root / "0.3/p", cellPressures(m, 2, false), {Encoding::Ascii, false},
+                                  "[1 -1 -2 0 0 0 0]");
+  try {
+    import(root, "mixed.h5", "0.1:0.3");
+    ADD_FAILURE() << "kinematic and Pa pressures in one case were accepted";
+  } catch (const rcfd::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("differ from those of the first time"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "units.h5"));
+}
+
 TEST_F(OpenFoamImport, DecomposedBinaryCaseGivesTheReconstructedDatabase) {
   import(writeReconstructed(), "reconstructed.h5");
   const auto result = import(writeDecomposed(), "decomposed.h5");
@@ -371,6 +445,9 @@ TEST_F(OpenFoamImport, EulerianParticlePhaseIsMappedByVolume) {
     }
   EXPECT_NEAR(f->u_p[0], wx / w, 1e-6);
   EXPECT_FALSE(rcfd::h5::File((dir_ / "db.h5").string(), rcfd::h5::File::Mode::ReadOnly).exists("/reference"));
+  EXPECT_TRUE(result.summary.at("reference").at("pressure_drop").is_null());
+  EXPECT_NE(result.summary.at("reference").at("pressure_drop_missing").get<std::string>().find("writes no p"),
+            std::string::npos);
 }
 
 // --- malformed input: an InputError naming the file and what was expected ---
@@ -458,6 +535,11 @@ TEST_F(OpenFoamImport, ImportJobWritesDatabaseResultAndSummary) {
   EXPECT_EQ(db->frameCount(), 4);
   rcfd::h5::File result((dir_ / "job/result.h5").string(), rcfd::h5::File::Mode::ReadOnly);
   EXPECT_EQ(result.readDoubles("/fields/alpha_p_mean").size(), 16u);
+  // ParaView opens both files through their sidecars (tests/paraview checks what it shows).
+  EXPECT_TRUE(fs::exists(dir_ / "job/database.xmf"));
+  EXPECT_TRUE(fs::exists(dir_ / "job/result.xmf"));
+  EXPECT_EQ(summary.at("figures"), json({"database_alpha_p.svg", "database_pressure_drop.svg"}));
+  for (const auto& f : summary.at("figures")) EXPECT_TRUE(fs::exists(dir_ / "job" / f.get<std::string>())) << f;
 }
 
 TEST_F(OpenFoamImport, JobSchemaTakesImportKeysOnlyForImportJobs) {

@@ -1,5 +1,6 @@
 // Every HDF5 file with fields that the jobs write opens in ParaView through its XDMF sidecar: a small
-// database job, a spray job and a calibration job on its database, then scripts/check-paraview.py in
+// database job, a spray job and a calibration job on its database, and an import job of a small
+// OpenFOAM case, then scripts/check-paraview.py in
 // ParaView's Python compares what ParaView shows (arrays, cell placement, values, time steps) with the
 // files read by h5py. Skipped, saying why, where ParaView's Python is not installed
 // (scripts/install-deps.sh installs it).
@@ -15,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "../import/FoamCaseWriter.hpp"
 #include "../stability/StabilityCases.hpp"
 #include "SmallScenes.hpp"
 #include "core/Xdmf.hpp"
@@ -56,15 +58,19 @@ CommandResult runCommand(const std::string& command) {
   return r;
 }
 
+
+/// The installed ParaView's Python, or a skip naming what to install.
+#define RCFD_REQUIRE_PARAVIEW(python)                                                                        \
+  const std::string python = paraviewPython();                                                               \
+  if (python.empty())                                                                                        \
+    GTEST_SKIP() << "ParaView's Python is not installed (neither $RCFD_PVPYTHON, pvpython nor python3 with " \
+                    "paraview.simple and h5py): install paraview, python3-paraview and python3-h5py "        \
+                    "(scripts/install-deps.sh)";
+
 }  // namespace
 
 TEST(ParaView, OpensEveryJobOutputThroughItsSidecar) {
-  const std::string python = paraviewPython();
-  if (python.empty()) {
-    GTEST_SKIP() << "ParaView's Python is not installed (neither $RCFD_PVPYTHON, pvpython nor python3 with "
-                    "paraview.simple and h5py): install paraview, python3-paraview and python3-h5py "
-                    "(scripts/install-deps.sh)";
-  }
+  RCFD_REQUIRE_PARAVIEW(python);
   const auto start = std::chrono::steady_clock::now();
   const fs::path dir = fs::path(testing::TempDir()) / ("paraview-" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -119,5 +125,63 @@ TEST(ParaView, OpensEveryJobOutputThroughItsSidecar) {
   if (check.exitCode == 77) GTEST_SKIP() << check.output;
   EXPECT_EQ(check.exitCode, 0) << command << "\n" << check.output;
   std::printf("jobs %.1f s, ParaView check %.1f s (%s)\n", jobSeconds, checkSeconds, python.c_str());
+  if (!HasFailure()) fs::remove_all(dir);
+}
+
+// The import job's database (frames over time) and result.h5 on a case of 2 x 2 mesh cells per grid cell.
+TEST(ParaView, OpensTheImportsOutputsThroughTheirSidecars) {
+  RCFD_REQUIRE_PARAVIEW(python);
+  const fs::path dir = fs::path(testing::TempDir()) / ("paraview-import-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const json scene = json::parse(R"({
+    "name": "paraview-import",
+    "apparatus": {"type": "box", "size": [0.04, 0.04, 0.01]},
+    "gas": {},
+    "grid": {"cell_size": 0.01},
+    "particles": {"diameter": 0.001, "density": 1000.0},
+    "process": {"bed_mass": 0.001},
+    "spray": {"nozzle_position": [0.0, 0.002, 0.005],
+              "spray_zone": {"apex": [0.0, 0.0, 0.005], "half_angle_deg": 45, "y_min": 0.01, "y_max": 0.03}},
+    "effects": []
+  })");
+  rcfd::test::LatticeMesh mesh;
+  for (int i = 0; i <= 8; ++i) mesh.xs.push_back(-0.02 + 0.005 * i);
+  for (int j = 0; j <= 8; ++j) mesh.ys.push_back(0.005 * j);
+  mesh.zs = {0.0, 0.01};
+  const fs::path root = dir / "case";
+  mesh.write(root / "constant/polyMesh", {rcfd::test::Encoding::Ascii, false});
+  for (int n = 1; n <= 4; ++n) {
+    const fs::path t = root / std::to_string(n);
+    std::vector<Eigen::Vector3d> gas;
+    std::vector<double> pressure;
+    for (const auto& c : mesh.cells()) {
+      gas.push_back({0.1 * n, 1.0 + mesh.centre(c).x(), 0.0});
+      pressure.push_back(100.0 - 1000.0 * mesh.centre(c).y());
+    }
+    rcfd::test::writeVolVectorField(t / "U.air", gas, {rcfd::test::Encoding::Ascii, false});
+    rcfd::test::writeVolScalarField(t / "p", pressure, {rcfd::test::Encoding::Ascii, false}, "[0 2 -2 0 0 0 0]");
+    std::vector<rcfd::test::TestParcel> parcels;
+    for (int k = 0; k < 6; ++k) {
+      rcfd::test::TestParcel p;
+      p.x = {-0.015 + 0.006 * k, 0.004 + 0.005 * ((k + n) % 6), 0.005};
+      p.u = {0.0, 0.5 * k, 0.0};
+      p.nParticle = 20;
+      p.origId = k;
+      parcels.push_back(p);
+    }
+    rcfd::test::writeCloud(t / "lagrangian/cloud", parcels, {rcfd::test::Encoding::Ascii, false});
+  }
+  const rcfd::stability::Outcome import = rcfd::stability::runJob(
+      {{"kind", "import"}, {"scene", scene}, {"case_dir", root.string()}}, dir / "import", 60.0, 1);
+  ASSERT_EQ(import.exitCode, 0) << import.describe();
+  const fs::path out = dir / "import" / "out";
+  std::string command = python + " " + std::string(RCFD_SOURCE_DIR) + "/scripts/check-paraview.py --grid " +
+                        (out / "database.h5").string() + " " + (out / "database.xmf").string() + " " +
+                        (out / "result.xmf").string();
+  for (const char* name : {"alpha_p", "u_p", "u_g", "grid/fluid_fraction", "fields/alpha_p_mean"})
+    command += std::string(" --expect ") + name;
+  const CommandResult check = runCommand(command);
+  if (check.exitCode == 77) GTEST_SKIP() << check.output;
+  EXPECT_EQ(check.exitCode, 0) << command << "\n" << check.output;
   if (!HasFailure()) fs::remove_all(dir);
 }
