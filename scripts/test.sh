@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds, and runs the whole test suite (what CI runs).
+# Installs dependencies, builds, and runs the whole test suite (what CI runs), then its sanitizer pass:
+# the areas of scripts/test-sanitized.sh under ASan + UBSan (docs/stability.md, "Sanitizers";
+# RCFD_TEST_SANITIZED=0 leaves it out).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -13,3 +15,7 @@ else
 fi
 cd build
 ctest --output-on-failure -j "$(nproc)" --timeout 600
+cd ..
+if [ "${RCFD_TEST_SANITIZED:-1}" != 0 ]; then
+  bash scripts/test-sanitized.sh
+fi

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "../SanitizedBuild.hpp"
 #include "ServerFixture.hpp"
 
 using namespace rcfd::test;
@@ -69,6 +70,11 @@ bool healthAnswersWithin(unsigned short port, double seconds) {
 }  // namespace
 
 TEST(ServerLimits, DescriptorsUsedUpNeitherSpinNorFloodTheLogAndTheServerRecovers) {
+  // The sanitizers' runtime tests whether memory is readable by writing it into a pipe: with every
+  // descriptor taken, UBSan's vptr check of Boost's error categories cannot, and reports an invalid
+  // vptr where there is none.
+  if (rcfd::test::kSanitizedBuild)
+    GTEST_SKIP() << "a sanitizer runtime needs free descriptors of its own (docs/stability.md, \"Sanitizers\")";
   TempDir dir;
   ServerProcess server(dir.path() / "data", "limits-token",
                        {"--workers", "0", "--idle-before-token", "2", "--max-connections", "1000",
@@ -85,7 +91,7 @@ TEST(ServerLimits, DescriptorsUsedUpNeitherSpinNorFloodTheLogAndTheServerRecover
   EXPECT_GE(linesContaining(log, "accept:"), 1) << "the descriptors did not run out: the test proves nothing";
   EXPECT_LE(linesContaining(log, "accept:"), 3) << log.substr(0, 2000);
   for (const int fd : held) ::close(fd);
-  EXPECT_TRUE(healthAnswersWithin(server.port(), 10.0));
+  EXPECT_TRUE(healthAnswersWithin(server.port(), 10.0)) << server.stderrText().substr(0, 4000);
   EXPECT_TRUE(server.alive());
 }
 
