@@ -14,11 +14,30 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 namespace rcfd::test {
+
+// Scene grid: box x in [-0.02, 0.02], y in [0, 0.04], z in [0, 0.01], cells of 0.01 m: 4 x 4 x 1.
+// Spray zone: cone from the apex (0, 0, 0.005), half-angle 45 deg, 0.01 <= y <= 0.03.
+inline nlohmann::json importTestScene() {
+  return nlohmann::json::parse(R"({
+    "name": "import-test",
+    "apparatus": {"type": "box", "size": [0.04, 0.04, 0.01]},
+    "gas": {},
+    "grid": {"cell_size": 0.01},
+    "particles": {"diameter": 0.001, "density": 1000.0},
+    "process": {"bed_mass": 0.001},
+    "spray": {"nozzle_position": [0.0, 0.002, 0.005],
+              "spray_zone": {"apex": [0.0, 0.0, 0.005], "half_angle_deg": 45, "y_min": 0.01, "y_max": 0.03}},
+    "probes": [{"name": "middle", "position": [0.005, 0.015, 0.005]}],
+    "effects": []
+  })");
+}
+
 
 enum class Encoding { Ascii, Binary };
 

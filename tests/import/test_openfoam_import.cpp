@@ -35,22 +35,7 @@ using rcfd::test::TestParcel;
 
 namespace {
 
-// Scene grid: box x in [-0.02, 0.02], y in [0, 0.04], z in [0, 0.01], cells of 0.01 m: 4 x 4 x 1.
-// Spray zone: cone from the apex (0, 0, 0.005), half-angle 45 deg, 0.01 <= y <= 0.03.
-json sceneDocument() {
-  return json::parse(R"({
-    "name": "import-test",
-    "apparatus": {"type": "box", "size": [0.04, 0.04, 0.01]},
-    "gas": {},
-    "grid": {"cell_size": 0.01},
-    "particles": {"diameter": 0.001, "density": 1000.0},
-    "process": {"bed_mass": 0.001},
-    "spray": {"nozzle_position": [0.0, 0.002, 0.005],
-              "spray_zone": {"apex": [0.0, 0.0, 0.005], "half_angle_deg": 45, "y_min": 0.01, "y_max": 0.03}},
-    "probes": [{"name": "middle", "position": [0.005, 0.015, 0.005]}],
-    "effects": []
-  })");
-}
+json sceneDocument() { return rcfd::test::importTestScene(); }
 
 // Mesh planes: two mesh cells of unequal width per grid cell along x and y, two along z.
 LatticeMesh latticeMesh() {

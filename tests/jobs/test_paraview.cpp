@@ -133,17 +133,7 @@ TEST(ParaView, OpensTheImportsOutputsThroughTheirSidecars) {
   RCFD_REQUIRE_PARAVIEW(python);
   const fs::path dir = fs::path(testing::TempDir()) / ("paraview-import-" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  const json scene = json::parse(R"({
-    "name": "paraview-import",
-    "apparatus": {"type": "box", "size": [0.04, 0.04, 0.01]},
-    "gas": {},
-    "grid": {"cell_size": 0.01},
-    "particles": {"diameter": 0.001, "density": 1000.0},
-    "process": {"bed_mass": 0.001},
-    "spray": {"nozzle_position": [0.0, 0.002, 0.005],
-              "spray_zone": {"apex": [0.0, 0.0, 0.005], "half_angle_deg": 45, "y_min": 0.01, "y_max": 0.03}},
-    "effects": []
-  })");
+  const json scene = rcfd::test::importTestScene();
   rcfd::test::LatticeMesh mesh;
   for (int i = 0; i <= 8; ++i) mesh.xs.push_back(-0.02 + 0.005 * i);
   for (int j = 0; j <= 8; ++j) mesh.ys.push_back(0.005 * j);
