@@ -429,7 +429,7 @@ ImportResult importOpenFoam(const Scene& scene, const ImportOptions& options) {
       reference["pressure_drop"] = nullptr;
       reference["pressure_drop_missing"] =
           c.pressureField.empty() ? "the case writes no " + kPressureNames.front() + ": no pressure drop"
-                                  : std::string("the grid is one cell high: no pressure drop between its rows");
+                                  : std::string("no mesh cell lies in the grid's lowest or highest row (or the grid is one cell high): no pressure drop between them");
     }
     summary["reference"] = reference;
   } catch (...) {
