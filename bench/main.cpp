@@ -6,8 +6,10 @@
 #include <map>
 #include <omp.h>
 #include <string>
+#include <vector>
 
 #include "BenchRegistry.hpp"
+#include "core/Isa.hpp"
 
 namespace rcfd::bench {
 namespace {
@@ -39,8 +41,10 @@ std::string cpuName() {
   return name + " (family " + family + ", model " + model + ")";
 }
 
-/// The widest vector instructions the build was compiled for (-march=native: the build machine's).
+/// The widest vector instructions the hot kernels run: the variant a portable build picked
+/// (core/Isa.hpp), or what a native build was compiled for.
 const char* vectorIsa() {
+  if (kernelIsa() != Isa::native) return isaName(kernelIsa());
 #if defined(__AVX512F__)
   return "avx512";
 #elif defined(__AVX2__)
@@ -51,6 +55,9 @@ const char* vectorIsa() {
   return "scalar";
 #endif
 }
+
+/// "portable" (kernel variants picked at run time) or "native" (-DRCFD_NATIVE=ON)
+const char* buildKind() { return builtIsas() == std::vector<Isa>{Isa::native} ? "native" : "portable"; }
 
 /// OMP_WAIT_POLICY as set, or "default" (libgomp spins a while before it sleeps, as the server and
 /// rcfd-solve run): on 2 threads a passive wait costs 0.4-0.5 ms per spray step, 7-10% of it, so a
@@ -90,6 +97,7 @@ int main(int argc, char** argv) {
   result["threads"] = options.threads > 0 ? options.threads : omp_get_max_threads();
   result["cpu"] = cpuName();
   result["vector_isa"] = vectorIsa();
+  result["build"] = rcfd::bench::buildKind();
   result["omp_wait_policy"] = waitPolicy();
   result["quick"] = options.quick;
   if (json) std::cout << result.dump() << std::endl;

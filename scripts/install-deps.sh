@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs rcfd's build and test dependencies from Debian 12 packages (run as root, or with sudo).
 # Every dependency of the project is named here; docker/Dockerfile installs the same list.
-#   --build-only  leaves out the tools only the tests use (ParaView, Chromium, Node.js, Slurm; the image
+#   --build-only  leaves out the tools only the tests use (ParaView, Chromium, Node.js, Slurm, QEMU; the image
 #                 of docker/Dockerfile builds without tests)
 set -euo pipefail
 test_tools=1
@@ -26,6 +26,7 @@ packages=(
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev       # micro-benchmarks
   zlib1g-dev             # the gzip-compressed files of OpenFOAM cases (rcfd-solve import-openfoam)
+  binutils               # ld -r, nm, objcopy: the AVX-512 kernel variant of a portable build (cmake/KernelVariants.cmake)
 )
 if [ "$test_tools" = 1 ]; then
   # The XDMF sidecars of the HDF5 outputs must open in ParaView: scripts/check-paraview.py opens them
@@ -40,6 +41,9 @@ if [ "$test_tools" = 1 ]; then
   # rcfd-server --executor slurm calls sbatch, squeue and scancel of the site's Slurm; the tests start
   # a single-node cluster of their own (tests/slurm: slurmctld, slurmd, munged).
   packages+=(slurm-wlm munge)
+  # The portable build on CPUs it cannot be run on here: qemu-x86_64 emulates an AVX2 CPU without
+  # AVX-512 and one without AVX2 (tests/portable).
+  packages+=(qemu-user)
   command -v node > /dev/null && command -v npm > /dev/null || packages+=(nodejs npm)
 fi
 missing=()

@@ -12,10 +12,15 @@
 #include <immintrin.h>
 #endif
 
+#include "core/IsaNamespace.hpp"
 #include "tracers/BlockSampling.hpp"
 #include "tracers/CellIndex.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FrameSampler.hpp"
+
+namespace rcfd {
+class ReferenceMotion;
+}
 
 namespace rcfd::block {
 
@@ -59,6 +64,8 @@ struct LaneStorage {
   }
 };
 
+inline namespace RCFD_ISA_NAMESPACE {
+
 /// The lanes k < n with v[k] > 0, in lane order, into `out`; returns their number. A bit mask of them
 /// first (eight lanes per compare with AVX2), then its set bits: where few lanes qualify, a lane-by-lane
 /// pass over all 64 costs more than the mask, and a branch per lane mispredicts.
@@ -92,6 +99,8 @@ inline int countLanesWithSubstepsLeft(const Lanes& lanes) {
   for (int k = 0; k < lanes.count; ++k) r += left[k] > 0 ? 1 : 0;
   return r;
 }
+
+}  // namespace RCFD_ISA_NAMESPACE
 
 /// A block whose lanes with sub-steps left after their first are at least this many takes those
 /// sub-steps in place (MotionKernel::advanceInPlace()), every lane in every round; fewer are deferred.
@@ -143,6 +152,8 @@ struct Context {
   double *cloudX = nullptr, *cloudY = nullptr, *cloudZ = nullptr;
   double *cloudVx = nullptr, *cloudVy = nullptr, *cloudVz = nullptr;
   bool keepVelocity = false;
+  /// The exact wall test for the moves the vectorised tests do not clear (ReferenceMotion::moveReflecting())
+  const ReferenceMotion* exact = nullptr;
   /// The tracers' cells after the move (TracerContext::nextTracerCell), or null; with `cellIndexer`.
   std::int32_t* nextCells = nullptr;
   const CellIndexer* cellIndexer = nullptr;
@@ -156,6 +167,7 @@ struct Cloud {
 /// What every block of a step reads besides the Context: the cloud and the step's per-tracer inputs.
 struct StepInputs {
   Cloud cloud{};
+  std::int64_t tracers = 0;                   ///< the cloud's size
   const Context* context = nullptr;
   const std::int32_t* ids = nullptr;          ///< the tracers' ids (their random streams)
   const FrameSampler* sampler = nullptr;      ///< alpha_P^rec (free flight)
@@ -166,6 +178,8 @@ struct StepInputs {
   const float *streamX = nullptr, *streamY = nullptr, *streamZ = nullptr;  ///< velocity_streams, or null
   double dt = 0.0;                            ///< [s]
   double inverseCellLimit = 0.0;              ///< 1 / (max_courant x smallest spacing) [1/m]
+  bool freeFlight = false;                    ///< MotionSettings::freeFlight
+  double freeFlightAlpha = 0.0;               ///< MotionSettings::freeFlightAlpha [-]
 };
 
 /// A block's lanes at the start of the step: their cells, which are in free flight, their cells' reach
@@ -185,6 +199,8 @@ struct ThreadLanes {
   DeferredLanes deferred, deferredFree;
   BlockStencils stencils;
 };
+
+inline namespace RCFD_ISA_NAMESPACE {
 
 /// Eq. (9): u = u_P^rec + u_fluc at the lanes' positions, located in float grid coordinates: into the
 /// lanes' velocities, and in float with the grid coordinates into `s` (the midpoint rule steps from them).
@@ -267,5 +283,7 @@ constexpr double kOneSubstepMargin = 1.0 - 1e-9;
   extra += added, capped += cappedHere;
   return maxLeft;
 }
+
+}  // namespace RCFD_ISA_NAMESPACE
 
 }  // namespace rcfd::block

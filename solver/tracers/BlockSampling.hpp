@@ -19,6 +19,7 @@
 #define RCFD_BLOCK_SAMPLING_AVX2 1
 #endif
 
+#include "core/IsaNamespace.hpp"
 #include "tracers/Trilinear.hpp"
 
 namespace rcfd::block {
@@ -181,6 +182,9 @@ struct CornerOffsets {
   }
 };
 
+// Code that differs by instruction set, and its callers: one definition per kernel variant.
+inline namespace RCFD_ISA_NAMESPACE {
+
 /// (ux[k], uy[k], uz[k]) = trilinear(field; stencil of lane k) for the lanes of a block located in `s`,
 /// in float. Written component by component (one store and two extracts per lane): a 4-float store per
 /// lane and a transposing loop after it took twice the instructions.
@@ -244,5 +248,7 @@ inline void sampleBlockFloat(const float* field, const CornerOffsets& co, const 
     ux[k] = double(fx[k]), uy[k] = double(fy[k]), uz[k] = double(fz[k]);
   }
 }
+
+}  // namespace RCFD_ISA_NAMESPACE
 
 }  // namespace rcfd::block

@@ -8,13 +8,11 @@
 #include <limits>
 #include <string>
 
-#include <omp.h>
-
 #include "core/Errors.hpp"
 #include "geometry/WallClearance.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/FluctuationModel.hpp"
-#include "tracers/BlockLanes.hpp"
+#include "tracers/BlockPath.hpp"
 #include "tracers/CellIndex.hpp"
 #include "tracers/SingleSphereDrag.hpp"
 #include "tracers/UnitVectors.hpp"
@@ -26,6 +24,7 @@ static_assert(std::endian::native == std::endian::little);
 
 MotionKernel::MotionKernel(const TracerContext& ctx, const MotionSettings& settings)
     : settings_(settings), apparatus_(ctx.apparatus), grid_(ctx.grid), reference_(ctx, settings) {
+  selectIsa(kernelIsa());
   // The block loops index the 4-float step field with int32 (4 x cells < 2^31).
   if (grid_.cellCount() > std::int64_t(1) << 29) {
     throw RunError("grid of " + std::to_string(grid_.cellCount()) + " cells: the tracer kernel supports at most 2^29");
@@ -148,132 +147,23 @@ block::Context MotionKernel::blockContext(const TrilinearLocator& locator, doubl
     if (!nearHalfSpaces_.empty()) bc.nearHalfSpaces = nearHalfSpaces_.data(), bc.nearReach2 = nearReach_ * nearReach_;
   }
   bc.keepVelocity = settings_.freeFlight;
+  bc.exact = &reference_;
   return bc;
 }
 
-void MotionKernel::startBlock(const block::StepInputs& in, std::int64_t i0, int count, block::BlockStart& b) const {
-  using block::kBlock;
-  // The lanes' cells: those tracer_volume_fraction found for the step (read in place), or found here.
-  b.cell = b.cellsFound;
-  if (in.tracerCell) {
-    b.cell = in.tracerCell + i0;
-  } else {
-    in.indexer->cellsOf(count, in.cloud.x + i0, in.cloud.y + i0, in.cloud.z + i0, b.cellsFound);
-  }
-  // `free` is read only where freeLanes > 0 (without free_flight, zeroing it was a memset per block).
-  b.freeLanes = 0;
-  if (settings_.freeFlight) {
-    for (int k = 0; k < count; ++k) {
-      b.free[k] = in.sampler->alphaP(b.cell[k]) < settings_.freeFlightAlpha;
-      b.freeLanes += b.free[k];
-    }
-  }
-  // A cell's reach and speed side by side: one 64-bit gather per lane for both.
-  const float* cellData = cellData_.data();
-  alignas(64) float speed[kBlock];
-#pragma omp simd
-  for (int k = 0; k < count; ++k) {
-    std::uint64_t pair;
-    std::memcpy(&pair, cellData + 2 * b.cell[k], sizeof pair);
-    b.reach[k] = std::bit_cast<float>(std::uint32_t(pair));
-    speed[k] = std::bit_cast<float>(std::uint32_t(pair >> 32));
-  }
-  if (b.freeLanes > 0) {  // none in free flight (a select: AVX2 has no vector int64-to-double conversion)
-#pragma omp simd
-    for (int k = 0; k < count; ++k) speed[k] = b.free[k] != 0 ? 0.0f : speed[k];
-  }
-  // Eq. (10): u_fluc = |u_fluc| n_rand, n_rand from the tracer's counter-based stream.
-  if (in.fluctuate) {
-#pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      float nx, ny, nz;
-      counterUnitVectorFloat(*in.rngPrefix, std::uint64_t(in.ids[i0 + k]), nx, ny, nz);  // the tracer's own stream
-      b.ax[k] = speed[k] * nx, b.ay[k] = speed[k] * ny, b.az[k] = speed[k] * nz;
-    }
-  } else {
-    for (int k = 0; k < count; ++k) b.ax[k] = b.ay[k] = b.az[k] = 0.0f;
-  }
-  // The tracer's stream velocity relative to u_P^rec (velocity_streams), held over the step as u_fluc is.
-  if (in.streamX) {
-#pragma omp simd
-    for (int k = 0; k < count; ++k) {
-      b.ax[k] += in.streamX[i0 + k], b.ay[k] += in.streamY[i0 + k], b.az[k] += in.streamZ[i0 + k];
-    }
+namespace block {
+MoveTracers moveTracersFor(Isa isa) {
+  switch (isa) {
+#if defined(RCFD_NATIVE_BUILD)
+    case Isa::native: return isa_native::moveTracers;
+#else
+    case Isa::avx2: return isa_avx2::moveTracers;
+    case Isa::avx512: return isa_avx512::moveTracers;
+#endif
+    default: throw RunError(std::string("the motion kernel has no ") + isaName(isa) + " variant in this build");
   }
 }
-
-namespace {
-/// The lanes of a block in free flight (or not) copied out of the cloud into `ls`, with their velocity
-/// (free flight's own) and, for the others, their u_fluc.
-block::Lanes takeLanes(bool freeFlying, const block::Cloud& cloud, std::int64_t i0, int count,
-                       const block::BlockStart& b, block::LaneStorage& ls) {
-  int j = 0;
-  for (int k = 0; k < count; ++k) {
-    if ((b.free[k] != 0) != freeFlying) continue;
-    const std::int64_t i = i0 + k;
-    ls.x[j] = cloud.x[i], ls.y[j] = cloud.y[i], ls.z[j] = cloud.z[i];
-    ls.ux[j] = cloud.vx[i], ls.uy[j] = cloud.vy[i], ls.uz[j] = cloud.vz[i];
-    ls.ax[j] = freeFlying ? 0.0f : b.ax[k], ls.ay[j] = freeFlying ? 0.0f : b.ay[k], ls.az[j] = freeFlying ? 0.0f : b.az[k];
-    ls.cell[j] = b.cell[k], ls.reach[j] = b.reach[k];
-    ls.lane[j++] = k;
-  }
-  return ls.view(j, true);
-}
-
-/// takeLanes()'s lanes back into the cloud.
-void putBack(const block::Lanes& lanes, const block::LaneStorage& ls, const block::Cloud& cloud, std::int64_t i0) {
-  for (int j = 0; j < lanes.count; ++j) {
-    const std::int64_t i = i0 + ls.lane[j];
-    cloud.x[i] = lanes.x[j], cloud.y[i] = lanes.y[j], cloud.z[i] = lanes.z[j];
-    cloud.vx[i] = lanes.ux[j], cloud.vy[i] = lanes.uy[j], cloud.vz[i] = lanes.uz[j];
-  }
-}
-}  // namespace
-
-void MotionKernel::moveBlock(const block::StepInputs& in, std::int64_t i0, int count, block::BlockStart& b,
-                             block::ThreadLanes& thread, MotionStatistics& st) const {
-  using namespace block;
-  const Context& bc = *in.context;
-  const Cloud& cloud = in.cloud;
-  // The lanes that follow u_P^rec: all of them, in place in the cloud's arrays (the velocity arrays hold
-  // u as it is computed), unless some are in free flight.
-  alignas(64) double h[kBlock];
-  alignas(64) std::int32_t left[kBlock];
-  LaneStorage compact;
-  // Velocities are kept in the cloud only for free flight, the one reader; otherwise they stay in the
-  // block (saves writing 24 bytes per tracer-step).
-  alignas(64) double sux[kBlock], suy[kBlock], suz[kBlock];
-  const bool keep = settings_.freeFlight;
-  Lanes L{cloud.x + i0, cloud.y + i0, cloud.z + i0, b.ax, b.ay, b.az, keep ? cloud.vx + i0 : sux,
-          keep ? cloud.vy + i0 : suy, keep ? cloud.vz + i0 : suz, h, left, count, b.cell, b.reach};
-  if (b.freeLanes > 0) L = takeLanes(false, cloud, i0, count, b, compact);
-  // Eq. (9): u_P^rec + u_fluc at the start, which sets the sub-steps.
-  sampleParticleVelocity(bc, L, thread.stencils);
-  auto countSubsteps = [&](Lanes& lanes) {
-    return substepsOfBlock(lanes.ux, lanes.uy, lanes.uz, lanes.count, in.dt, in.inverseCellLimit, bc.substepLength,
-                           double(kMaxSubsteps), lanes.h, lanes.left, st.substeps, st.substepCapped);
-  };
-  const bool more = countSubsteps(L) > 0;
-  subStep(L, thread.stencils, true, bc, st);
-  // The later sub-steps: in place when most lanes take them, else deferred.
-  const bool inPlace = more && countLanesWithSubstepsLeft(L) >= kInPlaceLanes;
-  if (inPlace) advanceInPlace(L, thread.stencils, bc, st), ++st.blocksInPlace;
-  // Copied back before deferring: deferring may finish lanes, whose results must not be overwritten.
-  if (b.freeLanes > 0) putBack(L, compact, cloud, i0);
-  if (more && !inPlace) {
-    defer(L, i0, b.freeLanes > 0 ? compact.lane : nullptr, thread.deferred, false, thread.stencils, bc, st);
-  }
-  if (b.freeLanes > 0) {
-    // Free flight: the tracers' own velocities, sub-stepped by them.
-    LaneStorage fs;
-    Lanes F = takeLanes(true, cloud, i0, count, b, fs);
-    st.freeFlight += F.count;
-    const bool moreFree = countSubsteps(F) > 0;
-    freeFlightSubStep(F, thread.stencils, bc, st);
-    putBack(F, fs, cloud, i0);
-    if (moreFree) defer(F, i0, fs.lane, thread.deferredFree, true, thread.stencils, bc, st);
-  }
-}
+}  // namespace block
 
 void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside) {
   using namespace block;
@@ -317,63 +207,16 @@ void MotionKernel::move(TracerContext& ctx, const std::function<void()>& beside)
   in.dt = dt;
   // Sub-steps so that none moves farther than max_courant cells.
   in.inverseCellLimit = 1.0 / (settings_.maxCourant * minSpacing_);
-
-  std::int64_t substeps = 0, wallHits = 0, freeFlight = 0, capped = 0, scalarPath = 0, exactWallTests = 0;
-  std::int64_t blocksInPlace = 0;
-  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
-  constexpr std::int64_t kChunk = 16;  // blocks
-  const std::int64_t chunks = (blocks + kChunk - 1) / kChunk;
-  // `beside` on the team's last thread, which then takes what chunks are left (an exception is carried
-  // out of the parallel region, which it must not leave).
-  std::exception_ptr besideFailure;
-#pragma omp parallel if (n > kParallelThreshold) \
-    reduction(+ : substeps, wallHits, freeFlight, capped, scalarPath, exactWallTests, blocksInPlace)
-  {
-  if (beside && omp_get_thread_num() == omp_get_num_threads() - 1) {
-    try {
-      beside();
-    } catch (...) {
-      besideFailure = std::current_exception();
-    }
-  }
-  // Defined in the region, so that it adds to the thread's copies of the reduction's counters.
-  auto addStatistics = [&](const MotionStatistics& st) {
-    substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
-    scalarPath += st.scalarPath, exactWallTests += st.exactWallTests, blocksInPlace += st.blocksInPlace;
-  };
-  // The thread's deferred lanes, carried from chunk to chunk so that their rounds run full.
-  ThreadLanes thread;
-#pragma omp for schedule(dynamic, 1) nowait
-  for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {
-    MotionStatistics st;
-    for (std::int64_t b = chunk * kChunk; b < std::min(blocks, (chunk + 1) * kChunk); ++b) {
-      const std::int64_t i0 = b * kBlock;
-      const int count = int(std::min<std::int64_t>(kBlock, n - i0));
-      BlockStart start;
-      startBlock(in, i0, count, start);
-      moveBlock(in, i0, count, start, thread, st);
-    }
-    if (nextCells) {  // the chunk's new positions are still in cache: their cells, for the next step
-      // (deferred lanes are between sub-steps: finishDeferred() writes their cells when it moves them)
-      const std::int64_t first = chunk * kChunk * kBlock, last = std::min(n, (chunk + 1) * kChunk * kBlock);
-      indexer.cellsOf(int(last - first), arrays.x + first, arrays.y + first, arrays.z + first, nextCells + first);
-    }
-    addStatistics(st);
-  }
-  MotionStatistics st;
-  finishDeferred(thread.deferred, false, thread.stencils, bc, st);
-  finishDeferred(thread.deferredFree, true, thread.stencils, bc, st);
-  addStatistics(st);
-  }
-  if (besideFailure) std::rethrow_exception(besideFailure);
+  in.tracers = n;
+  in.freeFlight = settings_.freeFlight;
+  in.freeFlightAlpha = settings_.freeFlightAlpha;
+  moveTracers_(in, beside, stats_);
   if (nextCells) ctx.nextTracerCellStep = ctx.step + 1;
-  stats_.substeps = substeps;
-  stats_.wallHits = wallHits;
-  stats_.freeFlight = freeFlight;
-  stats_.substepCapped = capped;
-  stats_.scalarPath = scalarPath;
-  stats_.exactWallTests = exactWallTests;
-  stats_.blocksInPlace = blocksInPlace;
+}
+
+void MotionKernel::selectIsa(Isa isa) {
+  moveTracers_ = block::moveTracersFor(isa);
+  isa_ = isa;
 }
 
 }  // namespace rcfd

@@ -9,12 +9,14 @@
 ///
 /// What a tracer does is defined by ReferenceMotion (ReferenceMotion.hpp), one tracer at a time. This
 /// kernel does the same to blocks of 64 tracers (block::kBlock) in loops the compiler vectorises; the
-/// test Kernel.BlockPathMatchesTheReferenceMotionOnRandomCases holds the two together. Its strategies:
+/// test Kernel.BlockPathMatchesTheReferenceMotionOnRandomCases holds the two together. The block path
+/// (BlockPath.cpp) is compiled once per instruction set (core/Isa.hpp) and runs the variant
+/// kernelIsa() picks. Its strategies:
 ///  - **Per-cell work once per step** (prepare()): Eq. (10)'s speed depends on the cell only, so it is
 ///    computed per cell, beside each cell's wall reach, and a lane reads both with one load.
 ///  - **Blocks in place** (startBlock(), moveBlock()): a block's lanes are the cloud's own arrays; only
 ///    a block with tracers in free flight copies its two kinds of lanes apart (takeLanes()).
-///  - **Two wall tests before the exact one** (moveLanes(), MotionKernelBlock.cpp): a move shorter
+///  - **Two wall tests before the exact one** (moveLanes()): a move shorter
 ///    than its cell's wall reach, or clear of every half-space of the open region near its cell and of
 ///    the plates, cannot meet a wall; only the others take ReferenceMotion's exact segment test.
 ///  - **Sub-steps three ways**: most tracers take one sub-step (the block's first pass); a block in
@@ -30,6 +32,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/Isa.hpp"
 #include "geometry/Apparatus.hpp"
 #include "tracers/MotionStatistics.hpp"
 #include "tracers/ReferenceMotion.hpp"
@@ -38,13 +41,8 @@
 
 namespace rcfd {
 namespace block {
-struct BlockStart;
-struct BlockStencils;
 struct Context;
-struct DeferredLanes;
-struct Lanes;
 struct StepInputs;
-struct ThreadLanes;
 }  // namespace block
 
 
@@ -61,6 +59,11 @@ class MotionKernel {
   void move(TracerContext& ctx, const std::function<void()>& beside = {});
   const MotionStatistics& statistics() const { return stats_; }
   const MotionSettings& settings() const { return settings_; }
+  /// The instruction set of the block path's variant: kernelIsa() unless selectIsa() chose another.
+  Isa isa() const { return isa_; }
+  /// Runs the block path's variant for `isa` (one of builtIsas() this CPU runs): tests and benchmarks
+  /// compare the variants on one machine.
+  void selectIsa(Isa isa);
 
   /// Moves p by disp, reflecting at walls (mirror of the remaining displacement); v is reflected with
   /// the restitution coefficient if `velocity` is non-null. Returns the number of reflections. The
@@ -73,37 +76,6 @@ class MotionKernel {
   void prepare(TracerContext& ctx, const FrameSampler& sampler, bool fluctuate);
   /// The step's constants of the block path: fields, grid and walls as plain values.
   block::Context blockContext(const TrilinearLocator& locator, double dt) const;
-  /// A block's start: its lanes' cells, which are in free flight, their cells' reach and u_fluc.
-  void startBlock(const block::StepInputs& in, std::int64_t i0, int count, block::BlockStart& b) const;
-  /// A block's move: its first sub-step, the later ones in place or deferred, and its free flight.
-  void moveBlock(const block::StepInputs& in, std::int64_t i0, int count, block::BlockStart& b,
-                 block::ThreadLanes& thread, MotionStatistics& st) const;
-  // The block path's sub-step rounds (MotionKernelBlock.cpp).
-  /// The sub-steps after the first of lanes: rounds on the lanes that still have some, compacted.
-  void advanceLanes(block::Lanes& lanes, std::int32_t maxLeft, block::BlockStencils& stencils, bool freeFlying,
-                    const block::Context& bc, MotionStatistics& st) const;
-  /// The sub-steps after the first of the lanes of a block in place, when most of its lanes have some
-  /// (in the spout every lane does): rounds over the whole block, in which the lanes without sub-steps
-  /// left stand still (a zero sub-step) and keep their velocity. Spares the copies of defer().
-  void advanceInPlace(block::Lanes& lanes, block::BlockStencils& stencils, const block::Context& bc,
-                      MotionStatistics& st) const;
-  /// Adds the lanes with sub-steps left (lane k is tracer i0 + k, or i0 + laneOf[k]) to `deferred`,
-  /// finishing its lanes whenever it is full.
-  void defer(const block::Lanes& lanes, std::int64_t i0, const std::int32_t* laneOf, block::DeferredLanes& deferred,
-             bool freeFlying, block::BlockStencils& stencils, const block::Context& bc, MotionStatistics& st) const;
-  /// The remaining sub-steps of deferred lanes, then their positions (and velocities) into the cloud.
-  void finishDeferred(block::DeferredLanes& deferred, bool freeFlying, block::BlockStencils& stencils,
-                      const block::Context& bc, MotionStatistics& st) const;
-  /// One sub-step of lanes along u_P^rec + u_fluc (sampled at the start already when `sampled`).
-  void subStep(block::Lanes& lanes, block::BlockStencils& stencils, bool sampled, const block::Context& bc,
-               MotionStatistics& st) const;
-  /// One sub-step of free-flying lanes: drag toward u_G^rec and gravity, then the move.
-  void freeFlightSubStep(block::Lanes& lanes, block::BlockStencils& stencils, const block::Context& bc,
-                         MotionStatistics& st) const;
-  /// The moves of a sub-step: the vectorised wall tests, then the exact segment test (and, for free
-  /// flight, the velocity's reflection) for the moves they do not clear.
-  void moveLanes(block::Lanes& lanes, const block::Context& bc, MotionStatistics& st, bool freeFlying) const;
-
   MotionSettings settings_;
   const Apparatus& apparatus_;
   const CartesianGrid& grid_;
@@ -119,6 +91,8 @@ class MotionKernel {
   double reynoldsPerSpeed_;       ///< d_P / nu_G [s/m]
   Eigen::Vector3d gravity_{0.0, -9.81, 0.0};
   MotionStatistics stats_;
+  Isa isa_ = Isa::avx2;
+  void (*moveTracers_)(const block::StepInputs&, const std::function<void()>&, MotionStatistics&) = nullptr;
   const StepVelocityField* particleVelocity_ = nullptr;  ///< u_P^rec of the step (TracerContext::stepFields)
   const StepVelocityField* gasVelocity_ = nullptr;       ///< u_G^rec of the step (free flight only)
   /// Per cell, the two numbers a tracer reads from its own cell, side by side so they cost one cache
