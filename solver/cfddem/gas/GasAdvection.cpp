@@ -9,43 +9,11 @@
 
 #include <algorithm>
 
+#include "cfddem/gas/FaceRates.hpp"
 #include "cfddem/gas/GasSolver.hpp"
+#include "core/Errors.hpp"
 
 namespace rcfd::gas {
-namespace {
-
-/// van Leer limited slope from the two one-sided differences (0 at an extremum).
-inline double limitedSlope(double forward, double backward) {
-  const double prod = forward * backward;
-  return prod > 0.0 ? 2.0 * prod / (forward + backward) : 0.0;
-}
-
-/// Adds to r the advection and viscosity of one axis at a face, Eq. (2): -a dphi/dx by second-order
-/// upwind with a van Leer limiter (first order at extrema) from limited values at the two half-points,
-/// and nu d2phi/dx2; w0..w4 are the face values at offsets -2..2 along the axis, h its spacing. Both
-/// upwind sides are formed and one selected, so a loop over faces stays branch-free.
-inline double addAdvectionDiffusion(double r, double a, double w0, double w1, double w2, double w3, double w4,
-                                    double h, double nu) {
-  const double plusUp = w2 + 0.5 * limitedSlope(w3 - w2, w2 - w1);
-  const double minusUp = w1 + 0.5 * limitedSlope(w2 - w1, w1 - w0);
-  const double plusDown = w3 - 0.5 * limitedSlope(w4 - w3, w3 - w2);
-  const double minusDown = w2 - 0.5 * limitedSlope(w3 - w2, w2 - w1);
-  const bool up = a >= 0;
-  const double plus = up ? plusUp : plusDown, minus = up ? minusUp : minusDown;
-  r -= a * (plus - minus) / h;
-  r += nu * (w3 - 2 * w2 + w1) / (h * h);  // alpha grad.tau / (alpha rho)
-  return r;
-}
-
-/// Adds to r a face's body and source terms: gravity, the explicit force per volume fe over
-/// (alpha rho), and the nozzle air entering with the jet velocity (+y), s (u_jet - u) / alpha.
-inline double addSources(double r, double gravity, double fe, double sF, double jet, double u, double aF,
-                         double rho) {
-  return r + gravity + fe / (aF * rho) + sF * (jet - u) / aF;
-}
-
-}  // namespace
-
 void GasSolver::buildStencils() {
   for (int d = 0; d < 3; ++d) {
     const auto& s = ap_.shape[std::size_t(d)];
@@ -167,71 +135,36 @@ double GasSolver::faceRate(const std::array<std::vector<double>, 3>& u, int d, i
   return addSources(r, options_.gravity[d], fe, sF, d == 1 ? nozzleJetVelocity_ : 0.0, ud[f], aF, rho);
 }
 
-void GasSolver::rowRates(const std::array<std::vector<double>, 3>& u, int d, int j, int k, int i0, int i1,
-                         double* out) const {
-  // faceRate on faces i0 <= i < i1 of row (j, k) of axis d, whose stencils along x stay inside the
-  // grid and whose neighbours along d exist: the same helpers in loops the compiler vectorises.
-  constexpr int kChunk = 64;
-  const Eigen::Vector3d hv = grid_.spacing;
-  const double nu = scene_.gas.kinematic_viscosity, rho = scene_.gas.density;
-  const auto n = grid_.shape;
-  const auto& sd = ap_.shape[std::size_t(d)];
-  const std::ptrdiff_t dStride[3] = {1, sd[0], std::ptrdiff_t(sd[0]) * sd[1]};
-  const std::ptrdiff_t cellStride[3] = {1, n[0], std::ptrdiff_t(n[0]) * n[1]};
-  const double* const ud = u[std::size_t(d)].data();
-  const char* const kinds = kind_[std::size_t(d)].data();
-  const int idx[3] = {0, j, k};
-  const double gravity = options_.gravity[d], jet = d == 1 ? nozzleJetVelocity_ : 0.0;
-  for (int c0 = i0; c0 < i1; c0 += kChunk) {
-    const int m = std::min(kChunk, i1 - c0);
-    const std::ptrdiff_t f0 = k * dStride[2] + j * dStride[1] + c0;
-    alignas(64) double r[kChunk];
-    for (int q = 0; q < m; ++q) r[q] = 0.0;
-    for (int e = 0; e < 3; ++e) {
-      alignas(64) double a[kChunk];
-      if (e == d) {
-        for (int q = 0; q < m; ++q) a[q] = ud[f0 + q];
-      } else {
-        const double* const ue = u[std::size_t(e)].data();
-        const auto& se = ap_.shape[std::size_t(e)];
-        const std::ptrdiff_t stride[3] = {1, se[0], std::ptrdiff_t(se[0]) * se[1]};
-        const double* const p0 = ue + (k * stride[2] + j * stride[1] + c0);
-        const double* const p1 = p0 + stride[e];
-        const double* const p2 = p0 - stride[d];
-        const double* const p3 = p2 + stride[e];
-#pragma omp simd
-        for (int q = 0; q < m; ++q) a[q] = 0.25 * (p0[q] + p1[q] + p2[q] + p3[q]);
-      }
-      // Inside along x (e = 0) the table gives shifts -2..2 and sign 1; along y and z the row's index
-      // is fixed, so one table entry serves the whole row.
-      const GhostPoint* g = &ghost_[std::size_t(d)][std::size_t(e)][std::size_t(e == 0 ? 2 : idx[e]) * 5];
-      const double* v0 = ud + f0 + g[0].shift * dStride[e];
-      const double* v1 = ud + f0 + g[1].shift * dStride[e];
-      const double* v2 = ud + f0 + g[2].shift * dStride[e];
-      const double* v3 = ud + f0 + g[3].shift * dStride[e];
-      const double* v4 = ud + f0 + g[4].shift * dStride[e];
-      const double s0 = g[0].sign, s1 = g[1].sign, s2 = g[2].sign, s3 = g[3].sign, s4 = g[4].sign;
-      const double spacing = hv[e];
-#pragma omp simd
-      for (int q = 0; q < m; ++q)
-        r[q] = addAdvectionDiffusion(r[q], a[q], s0 * v0[q], s1 * v1[q], s2 * v2[q], s3 * v3[q], s4 * v4[q], spacing, nu);
-    }
-    const std::ptrdiff_t ch0 = (std::ptrdiff_t(k) * n[1] + j) * n[0] + c0, cl0 = ch0 - cellStride[d];
-    const double* const fx = fExplicit_.data()->data();
-#pragma omp simd
-    for (int q = 0; q < m; ++q) {
-      const std::ptrdiff_t ch = ch0 + q, cl = cl0 + q;
-      const double aF = 0.5 * (alphaNext_[std::size_t(cl)] + alphaNext_[std::size_t(ch)]);
-      const double fe = 0.5 * (fx[3 * cl + d] + fx[3 * ch + d]);
-      const double sF = 0.5 * (source_[std::size_t(cl)] + source_[std::size_t(ch)]);
-      const double rate = addSources(r[q], gravity, fe, sF, jet, ud[f0 + q], aF, rho);
-      out[f0 + q] = kinds[f0 + q] == Interior ? rate : 0.0;
-    }
+FaceRows faceRowsFor(Isa isa) {
+  switch (isa) {
+#if defined(RCFD_NATIVE_BUILD)
+    case Isa::native: return isa_native::faceRows;
+#else
+    case Isa::avx2: return isa_avx2::faceRows;
+    case Isa::avx512: return isa_avx512::faceRows;
+#endif
+    default: throw RunError(std::string("the gas's face rates have no ") + isaName(isa) + " variant in this build");
   }
 }
 
 void GasSolver::explicitRates(const std::array<std::vector<double>, 3>& u,
                               std::array<std::vector<double>, 3>& rate) const {
+  FaceRowInputs rows;
+  for (int d = 0; d < 3; ++d) {
+    rows.u[d] = u[std::size_t(d)].data();
+    rows.kinds[d] = kind_[std::size_t(d)].data();
+    rows.faceShape[d] = ap_.shape[std::size_t(d)];
+    rows.spacing[d] = grid_.spacing[d];
+    rows.gravity[d] = options_.gravity[d];
+    for (int e = 0; e < 3; ++e) rows.ghost[d][e] = ghost_[std::size_t(d)][std::size_t(e)].data();
+  }
+  rows.cells = grid_.shape;
+  rows.interior = Interior;
+  rows.nu = scene_.gas.kinematic_viscosity, rows.rho = scene_.gas.density;
+  rows.jet = nozzleJetVelocity_;
+  rows.alphaNext = alphaNext_.data();
+  rows.fExplicit = fExplicit_.data()->data();
+  rows.source = source_.data();
   for (int d = 0; d < 3; ++d) {
     const auto& s = ap_.shape[std::size_t(d)];
     double* const out = rate[std::size_t(d)].data();
@@ -250,7 +183,7 @@ void GasSolver::explicitRates(const std::array<std::vector<double>, 3>& u,
           continue;
         }
         for (int i = 0; i < i0; ++i) out[row + std::size_t(i)] = faceRate(u, d, i, j, k);
-        rowRates(u, d, j, k, i0, i1, out);
+        faceRows_(rows, d, j, k, i0, i1, out);
         for (int i = i1; i < s[0]; ++i) out[row + std::size_t(i)] = faceRate(u, d, i, j, k);
         if (nearBaffle)  // the plates' mirror images: the scalar path, for the few faces beside a plate
           for (int i = i0; i < i1; ++i)

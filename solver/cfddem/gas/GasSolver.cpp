@@ -28,7 +28,8 @@ std::string cellText(const CartesianGrid& g, std::size_t c) {
 
 GasSolver::GasSolver(const Scene& scene, const Apparatus& apparatus, const CartesianGrid& grid,
                      GasOptions options)
-    : scene_(scene), apparatus_(apparatus), grid_(grid), options_(std::move(options)) {
+    : scene_(scene), apparatus_(apparatus), grid_(grid), options_(std::move(options)),
+      faceRows_(faceRowsFor(kernelIsa())) {
   pressureSolver_ = std::make_unique<PressureSolver>(
       PreconditionerRegistry::createAt("scene", "/gas/pressure_preconditioner", scene_.gas.pressure_preconditioner),
       options_.refactorInterval);

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cfddem/gas/FaceApertures.hpp"
+#include "cfddem/gas/FaceRates.hpp"
 #include "cfddem/gas/PressureSolver.hpp"
 #include "geometry/Apparatus.hpp"
 #include "geometry/CartesianGrid.hpp"
@@ -156,9 +157,6 @@ class GasSolver {
   void buildStencils();
   /// The explicit rate of face (i, j, k) of axis d (0 for a face that is not interior).
   double faceRate(const std::array<std::vector<double>, 3>& u, int d, int i, int j, int k) const;
-  /// faceRate of the faces i0 <= i < i1 of row (j, k) of axis d into out (the axis' rate array),
-  /// vectorised; only for faces with their x-stencil inside the grid and both cells along d.
-  void rowRates(const std::array<std::vector<double>, 3>& u, int d, int j, int k, int i0, int i1, double* out) const;
   /// Whether a baffle (thin plate) closes the way from face idx of axis d to its neighbour at +e.
   bool baffleAhead(int d, int e, std::array<int, 3> idx) const;
   /// Stencil values v[0..4] (offsets -2..2 along e of face idx, axis d): no-slip mirror at baffles.
@@ -234,12 +232,7 @@ class GasSolver {
   /// Per axis and face: indices in matrix_'s values of (lo, lo), (hi, hi), (lo, hi), (hi, lo) of an
   /// interior face, [0] = (lo, lo) of an outlet face.
   std::array<std::vector<std::array<int, 4>>, 3> matrixSlot_;
-  /// Stencil point of explicitRates: the face value at offset m along e of a face at index x along e
-  /// is sign * u[face + shift * stride_e] (shift = m inside the grid, a mirror or copy outside).
-  struct GhostPoint {
-    int shift = 0;
-    double sign = 1.0;
-  };
+  FaceRows faceRows_;  ///< the row loop of explicitRates(), in the variant kernelIsa() picks
   std::array<std::array<std::vector<GhostPoint>, 3>, 3> ghost_;  ///< [d][e][x * 5 + m + 2]
   std::array<std::vector<std::uint8_t>, 3> nearBaffle_;          ///< [d][face]: bit e, empty without baffles
   /// Per axis and face, its gas area A a alpha_G [m2] (0 where closed): computed once per projection
