@@ -19,18 +19,32 @@
 #include <optional>
 #include <random>
 
+#include "core/Errors.hpp"
 #include "core/Permutation.hpp"
 #include "spray/DepositionEfficiency.hpp"
+#include "spray/DueCellScan.hpp"
 #include "spray/SprayState.hpp"
 #include "tracers/CounterRng.hpp"
 #include "tracers/StepField.hpp"
 #include "tracers/TracerEffect.hpp"
 
 namespace rcfd {
+
+spray::DueCellScan spray::dueCellScanFor(Isa isa) {
+  switch (isa) {
+#if defined(RCFD_NATIVE_BUILD)
+    case Isa::native: return isa_native::tracersInDueCells;
+#else
+    case Isa::avx2: return isa_avx2::tracersInDueCells;
+    case Isa::avx512: return isa_avx512::tracersInDueCells;
+#endif
+    default: throw RunError(std::string("the deposition's scan has no ") + isaName(isa) + " variant in this build");
+  }
+}
+
 namespace {
 
 constexpr std::int64_t kPicksPerBinomial = 32;  ///< see DepositionEffect::distribute
-constexpr std::int64_t kScanBlock = 256;        ///< tracers tested together in DepositionEffect::handOut
 /// Whole droplets one cell hands out in one step at most: 2^53, below which whole numbers are exact in
 /// double (and far inside int64). Reached only by droplets of a fraction of a micrometre.
 constexpr double kMaxDropletsPerHandOut = 9007199254740992.0;
@@ -38,7 +52,8 @@ constexpr double kMaxDropletsPerHandOut = 9007199254740992.0;
 class DepositionEffect final : public TracerEffect, public ParcelDeposition {
  public:
   explicit DepositionEffect(TracerContext& ctx)
-      : model_(DepositionModelRegistry::create(ctx.scene.spray.deposition_model)), state_(ctx.spray) {
+      : model_(DepositionModelRegistry::create(ctx.scene.spray.deposition_model)), state_(ctx.spray),
+        scanDueCells_(spray::dueCellScanFor(kernelIsa())) {
     constants_.particleDiameter = ctx.scene.particles.diameter;
     constants_.dropletDiameter = ctx.scene.spray.droplet_diameter;
     constants_.dropletDensity = ctx.scene.spray.droplet_density;
@@ -167,20 +182,7 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
       const std::int64_t first = n * t / used, last = n * (t + 1) / used;
       auto& mine = found_[std::size_t(t)];
       mine.clear();
-      // Blocks of tracers tested against the bitmap of the cells with droplets due (9 KB for 74k cells,
-      // in L1, where the slot array is not), in a loop that vectorises (a gather per 16 tracers); the
-      // few blocks with a member are then walked tracer by tracer, in order.
-      for (std::int64_t i0 = first; i0 < last; i0 += kScanBlock) {
-        const int count = int(std::min(kScanBlock, last - i0));
-        const std::int32_t* cells = cellOf + i0;
-        std::uint32_t any = 0;
-#pragma omp simd reduction(| : any)
-        for (int k = 0; k < count; ++k) any |= dueBit(dueBits, cells[k]);
-        if (any == 0) continue;
-        for (int k = 0; k < count; ++k) {
-          if (dueBit(dueBits, cells[k])) mine.push_back(std::int32_t(i0 + k));
-        }
-      }
+      scanDueCells_(dueBits, cellOf, first, last, mine);
     }
     for (const std::int32_t c : slotCells_) dueBits_[std::size_t(c) >> 5] = 0;
     found_.resize(std::size_t(team));
@@ -211,7 +213,6 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
   }
 
   /// Bit `cell` of a bitmap as 0 or 1 (a signed index: GCC gathers with it, not with an unsigned one).
-  static std::uint32_t dueBit(const std::uint32_t* bits, std::int32_t cell) { return (bits[cell >> 5] >> (cell & 31)) & 1u; }
 
   /// Hands `droplets` whole droplets to the tracers members_[start, end) with equal probability each: a
   /// multinomial draw. Up to kPicksPerBinomial droplets per tracer: one uniform pick per droplet; more:
@@ -253,6 +254,7 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
 
   std::unique_ptr<DepositionModel> model_;
   std::shared_ptr<SprayState> state_;
+  spray::DueCellScan scanDueCells_;  ///< the tracers of the cells with droplets due, in the variant kernelIsa() picks
   DepositionConstants constants_;
   // Of the step the parcels are moving in (beginStep):
   const CartesianGrid* grid_ = nullptr;
