@@ -20,8 +20,8 @@ for bench in "$@"; do
   steps=$((RCFD_BENCH_STEPS + 1))  # the timed steps and the untimed first one
   echo "== $bench ($tracers tracers, $steps steps)"
   callgrind_annotate "$out/cg" 2> /dev/null |
-    grep -E '(MotionKernel|block::)[A-Za-z:]*' |
-    sed -E 's/^ *([0-9,]+) .*(rcfd::[A-Za-z_:]+)\(.*/\1 \2/' | tr -d ',' |
+    grep -E '(MotionKernel|block::)[A-Za-z:]*' | sed -e 's/(anonymous namespace):://g' |
+    sed -E 's/^ *([0-9,]+) .*(rcfd::[A-Za-z0-9_:]+)\(.*/\1 \2/' | tr -d ',' |
     awk -v n="$tracers" -v s="$steps" '{ total += $1; printf "%8.1f  %s\n", $1 / (n * s), $2 }
       END { printf "%8.1f  instructions per tracer-step in all\n", total / (n * s) }'
 done
