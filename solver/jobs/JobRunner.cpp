@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "core/Errors.hpp"
+#include "core/Isa.hpp"
 
 namespace rcfd {
 
@@ -22,6 +23,7 @@ nlohmann::json runJob(const JobSpec& job, const RunOptions& options) {
   auto runner = JobRunnerRegistry::createAt("job", "/kind", job.kind);  // an unknown kind makes no DIR
   std::filesystem::create_directories(options.outDir);
   nlohmann::json summary = runner->run(job, options);
+  summary["kernel_isa"] = isaName(kernelIsa());  // which bits to expect (docs/contracts.md, "Determinism")
   writeFileAtomically(options.outDir + "/summary.json", summary.dump(2) + "\n");
   return summary;
 }

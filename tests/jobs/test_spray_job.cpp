@@ -13,6 +13,7 @@
 
 #include "SolveProcess.hpp"
 #include "core/Hdf5.hpp"
+#include "core/Isa.hpp"
 #include "fields/AnalyticDatabase.hpp"
 #include "geometry/Apparatus.hpp"
 #include "scene/SceneLoader.hpp"
@@ -127,6 +128,7 @@ TEST_F(SprayJob, RunsAndReportsProgressAndTheContractKeys) {
   }
   EXPECT_EQ(s["steps"].get<int>(), 80);
   EXPECT_EQ(s["status"], "succeeded");
+  EXPECT_EQ(s["kernel_isa"], rcfd::isaName(rcfd::kernelIsa()));  // the solver runs on this CPU with this environment
   const auto& m = s["mass_balance"];
   EXPECT_LE(std::abs(m["closure_error_kg"].get<double>()), 1e-9 * m["injected_kg"].get<double>());
   EXPECT_TRUE(fs::exists(dir_ / "a" / "result.h5"));
