@@ -64,6 +64,8 @@ struct LaneStorage {
   }
 };
 
+// Code that differs by instruction set, and its callers: one definition per kernel variant
+// (core/IsaNamespace.hpp).
 inline namespace RCFD_ISA_NAMESPACE {
 
 /// The lanes k < n with v[k] > 0, in lane order, into `out`; returns their number. A bit mask of them
@@ -200,6 +202,8 @@ struct ThreadLanes {
   BlockStencils stencils;
 };
 
+// Code that differs by instruction set, and its callers: one definition per kernel variant
+// (core/IsaNamespace.hpp).
 inline namespace RCFD_ISA_NAMESPACE {
 
 /// Eq. (9): u = u_P^rec + u_fluc at the lanes' positions, located in float grid coordinates: into the
