@@ -1,7 +1,7 @@
 #pragma once
 /// \file BlockLanes.hpp
 /// The motion kernel's block path (internal): the lanes of a block of tracers that move together
-/// through one sub-step round, and the step's constants those rounds read as plain values (the
+/// through one sub-step pass, and the step's constants those passes read as plain values (the
 /// vectoriser does not look through members of the kernel).
 
 #include <bit>
@@ -24,16 +24,16 @@ class ReferenceMotion;
 
 namespace rcfd::block {
 
-/// Tracer lanes of a block that move along u_P^rec (not in free flight), in one sub-step round: views
+/// Tracer lanes of a block that move along u_P^rec (not in free flight), in one sub-step pass: views
 /// of the cloud's arrays (the common case, no copies) or of a LaneStorage (compacted lanes).
 struct Lanes {
   double *x, *y, *z;         ///< position [m]
   const float *ax, *ay, *az;  ///< u_fluc of Eq. (10) [m/s]
   double *ux, *uy, *uz;      ///< velocity of the sub-step [m/s]
   double* h;                 ///< sub-step [s]
-  std::int32_t* left;        ///< sub-steps still to take after this round
+  std::int32_t* left;        ///< sub-steps still to take after this pass
   int count = 0;
-  /// The cells of the positions (the step's first round: the tracers' cells), or null (later rounds)
+  /// The cells of the positions (the step's first pass: the tracers' cells), or null (later passes)
   const std::int32_t* cell = nullptr;
   /// With `cell`: each lane's MotionKernel::cellData_ reach, loaded with its Eq. (10) speed
   const float* reach = nullptr;
@@ -53,7 +53,7 @@ struct LaneStorage {
     return {x, y, z, ax, ay, az, ux, uy, uz, h, left, count, withCells ? cell : nullptr, withCells ? reach : nullptr};
   }
   /// Copies lane k of `from` (position, u_fluc, sub-step, sub-steps left, and the velocity if
-  /// `velocity`) into lane j. A round along u_P^rec samples its velocity before reading it, so only
+  /// `velocity`) into lane j. A pass along u_P^rec samples its velocity before reading it, so only
   /// free flight needs the velocity copied in.
   void copyLane(const Lanes& from, int k, int j, bool velocity) {
     x[j] = from.x[k], y[j] = from.y[k], z[j] = from.z[k];
@@ -105,15 +105,15 @@ inline int countLanesWithSubstepsLeft(const Lanes& lanes) {
 }  // namespace RCFD_ISA_NAMESPACE
 
 /// A block whose lanes with sub-steps left after their first are at least this many takes those
-/// sub-steps in place (MotionKernel::advanceInPlace()), every lane in every round; fewer are deferred.
-/// Break-even: a deferred lane costs its copies plus its share of a full round, a round in place
-/// about as much as 64 lanes' rounds; in the benchmark's spout every lane has one.
+/// sub-steps in place (advanceInPlace(), BlockPath.cpp), every lane in every pass; fewer are deferred.
+/// Break-even: a deferred lane costs its copies plus its share of a full pass, a pass in place
+/// about as much as 64 lanes' passes; in the benchmark's spout every lane has one.
 constexpr int kInPlaceLanes = 32;
 
 /// Lanes, from the blocks a thread moves, with sub-steps left after their first: moved together when
 /// the storage is full or the thread has no chunk left, so later sub-steps run on full vectors rather
-/// than on the one or two lanes a block has (each round has a fixed cost, which per-block rounds of
-/// a few lanes would pay many times). Which lanes share a round depends on the schedule; a lane's
+/// than on the one or two lanes a block has (each pass has a fixed cost, which per-block passes of
+/// a few lanes would pay many times). Which lanes share a pass depends on the schedule; a lane's
 /// arithmetic does not.
 struct DeferredLanes {
   LaneStorage s;
@@ -121,7 +121,7 @@ struct DeferredLanes {
   int count = 0;
 };
 
-/// What every sub-step round of a move() reads: the step field, the grid and the walls as plain values.
+/// What every sub-step pass of moveTracers() reads: the step field, the grid and the walls as plain values.
 struct Context {
   const float* field = nullptr;     ///< u_P^rec of the step, 4 floats per cell
   const float* gasField = nullptr;  ///< u_G^rec of the step, 4 floats per cell (free flight only)
@@ -195,7 +195,7 @@ struct BlockStart {
   std::int64_t freeLanes = 0;
 };
 
-/// A thread's lanes with sub-steps left, carried from block to block so that their rounds run full,
+/// A thread's lanes with sub-steps left, carried from block to block so that their passes run full,
 /// and its stencils.
 struct ThreadLanes {
   DeferredLanes deferred, deferredFree;

@@ -21,7 +21,7 @@
 namespace rcfd::block::RCFD_ISA_NAMESPACE {
 namespace {
 
-// The sub-step rounds. Each takes the step's constants `bc` and adds what it did to `st`.
+// The sub-step passes. Each takes the step's constants `bc` and adds what it did to `st`.
 /// One sub-step of lanes along u_P^rec + u_fluc (sampled at the start already when `sampled`).
 void subStep(Lanes& lanes, BlockStencils& stencils, bool sampled, const Context& bc, MotionStatistics& st);
 /// One sub-step of free-flying lanes: drag toward u_G^rec and gravity, then the move.
@@ -29,11 +29,11 @@ void freeFlightSubStep(Lanes& lanes, BlockStencils& stencils, const Context& bc,
 /// The moves of a sub-step: the vectorised wall tests, then the exact segment test (and, for free
 /// flight, the velocity's reflection) for the moves they do not clear.
 void moveLanes(Lanes& lanes, const Context& bc, MotionStatistics& st, bool freeFlying);
-/// The sub-steps after the first of lanes: rounds on the lanes that still have some, compacted.
+/// The sub-steps after the first of lanes: passes on the lanes that still have some, compacted.
 void advanceLanes(Lanes& lanes, std::int32_t maxLeft, BlockStencils& stencils, bool freeFlying, const Context& bc,
                   MotionStatistics& st);
 /// The sub-steps after the first of the lanes of a block in place, when most of its lanes have some
-/// (in the spout every lane does): rounds over the whole block, in which the lanes without sub-steps
+/// (in the spout every lane does): passes over the whole block, in which the lanes without sub-steps
 /// left stand still (a zero sub-step) and keep their velocity. Spares the copies of defer().
 void advanceInPlace(Lanes& lanes, BlockStencils& stencils, const Context& bc, MotionStatistics& st);
 /// Adds the lanes with sub-steps left (lane k is tracer i0 + k, or i0 + laneOf[k]) to `deferred`,
@@ -91,7 +91,7 @@ void moveLanes(Lanes& L, const Context& bc, MotionStatistics& st, bool freeFlyin
     length2[k] = dx * dx + dy * dy + dz * dz;
   }
   if (startCell) {
-    // The lanes' cells are known (the step's first round): the bound with |p - c| <= half a diagonal
+    // The lanes' cells are known (the step's first pass): the bound with |p - c| <= half a diagonal
     // spares locating every start point. (A separate loop: a branch inside stops the vectoriser.)
 #pragma omp simd reduction(+ : pending)
     for (int k = 0; k < m; ++k) {
@@ -247,10 +247,10 @@ void advanceLanes(Lanes& L, std::int32_t maxLeft, BlockStencils& s, bool freeFly
     LaneStorage rs;
     const int r = lanesWithSubstepsLeft(L, rs.lane);
     if (r == L.count) {
-      // Every lane takes this round (always the first round of deferred lanes): in place, no copies.
+      // Every lane takes this pass (always the first pass of deferred lanes): in place, no copies.
       for (int k = 0; k < r; ++k) --L.left[k];
       Lanes all = L;
-      all.cell = nullptr, all.reach = nullptr;  // later rounds: the cells are not known
+      all.cell = nullptr, all.reach = nullptr;  // later passes: the cells are not known
       subStepRound(all);
       continue;
     }
@@ -275,7 +275,7 @@ void advanceInPlace(Lanes& L, BlockStencils& s, const Context& bc,
   alignas(64) double h[kBlock], ux[kBlock], uy[kBlock], uz[kBlock];
   alignas(64) std::int32_t on[kBlock];
   Lanes all = L;
-  all.h = h, all.ux = ux, all.uy = uy, all.uz = uz;  // a round reads no `left`
+  all.h = h, all.ux = ux, all.uy = uy, all.uz = uz;  // a pass reads no `left`
   all.cell = nullptr, all.reach = nullptr;  // the cells are not known after the first sub-step
   for (;;) {
     std::int32_t active = 0;
@@ -484,7 +484,7 @@ void moveTracers(const StepInputs& in, const std::function<void()>& beside, Moti
     substeps += st.substeps, wallHits += st.wallHits, freeFlight += st.freeFlight, capped += st.substepCapped;
     scalarPath += st.scalarPath, exactWallTests += st.exactWallTests, blocksInPlace += st.blocksInPlace;
   };
-  // The thread's deferred lanes, carried from chunk to chunk so that their rounds run full.
+  // The thread's deferred lanes, carried from chunk to chunk so that their passes run full.
   ThreadLanes thread;
 #pragma omp for schedule(dynamic, 1) nowait
   for (std::int64_t chunk = 0; chunk < chunks; ++chunk) {

@@ -1,6 +1,5 @@
 // The kernel variant a process runs (core/Isa.hpp): the best one this CPU runs, or the one RCFD_ISA
 // names, which must be built and run here.
-#include <cstdlib>
 #include <optional>
 #include <string>
 
@@ -8,35 +7,10 @@
 
 #include "core/Errors.hpp"
 #include "core/Isa.hpp"
+#include "../ScopedVariable.hpp"
 
 namespace rcfd {
-namespace {
-
-/// Sets (or unsets, with nullopt) an environment variable for the scope.
-class ScopedVariable {
- public:
-  ScopedVariable(const char* name, std::optional<std::string> value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    if (value) {
-      ::setenv(name, value->c_str(), 1);
-    } else {
-      ::unsetenv(name);
-    }
-  }
-  ~ScopedVariable() {
-    if (old_) {
-      ::setenv(name_, old_->c_str(), 1);
-    } else {
-      ::unsetenv(name_);
-    }
-  }
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
-
-}  // namespace
+using test::ScopedVariable;
 
 TEST(Isa, TheKernelsRunTheBestBuiltVariantThisCpuRuns) {
   const ScopedVariable unset("RCFD_ISA", std::nullopt);

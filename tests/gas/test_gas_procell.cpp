@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <iostream>
 #include <numbers>
 #include <string>
 #include <vector>
 
 #include "GasTestSupport.hpp"
+#include "../ScopedVariable.hpp"
 #include "cfddem/gas/FaceApertures.hpp"
 #include "core/Errors.hpp"
 #include "core/Isa.hpp"
@@ -68,13 +68,11 @@ TEST(GasProCell, MassConservedWithoutPlates) { expectMassConserved(false); }
 // The face-rate row loop in every variant this CPU runs (core/Isa.hpp): the same flow through the slice
 // with its plates after 15 steps, to round-off (they agree bit for bit on the machines measured).
 TEST(GasProCell, EveryKernelVariantGivesTheSameFlow) {
-  const char* old = std::getenv("RCFD_ISA");
-  const std::string kept = old ? old : "";
   std::vector<std::vector<double>> first;
   Isa firstIsa = Isa::native;
   for (Isa isa : builtIsas()) {
     if (!cpuRuns(isa)) continue;
-    ::setenv("RCFD_ISA", isaName(isa), 1);
+    const test::ScopedVariable variant("RCFD_ISA", isaName(isa));
     GasCase c(quickSliceScene(true));
     for (int n = 0; n < 15; ++n) c.solver->step(1.0);
     std::vector<std::vector<double>> u;
@@ -93,11 +91,6 @@ TEST(GasProCell, EveryKernelVariantGivesTheSameFlow) {
               << " m/s of " << scale << " m/s\n";
     EXPECT_LE(worst, 1e-12 * scale) << isaName(isa);
     EXPECT_GT(scale, 1.0);
-  }
-  if (old) {
-    ::setenv("RCFD_ISA", kept.c_str(), 1);
-  } else {
-    ::unsetenv("RCFD_ISA");
   }
 }
 TEST(GasProCell, MassConservedWithPlates) { expectMassConserved(true); }

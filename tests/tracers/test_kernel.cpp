@@ -20,6 +20,7 @@
 #include "tracers/SingleSphereDrag.hpp"
 #include "tracers/UnitVectors.hpp"
 #include "TracerTestSupport.hpp"
+#include "../ScopedVariable.hpp"
 
 using namespace rcfd;
 using namespace rcfd::test;
@@ -567,9 +568,7 @@ TEST(Kernel, BlockPathMatchesTheReferenceMotionOnRandomCases) {
   for (Isa isa : builtIsas()) {
     if (!cpuRuns(isa)) continue;
     ++variants;
-    const char* old = std::getenv("RCFD_ISA");
-    const std::string kept = old ? old : "";
-    ::setenv("RCFD_ISA", isaName(isa), 1);  // the variant every kernel built from here runs
+    const test::ScopedVariable variant("RCFD_ISA", isaName(isa));  // every kernel built from here runs it
     std::int64_t substeps = 0, freeFlying = 0, wallHits = 0, capped = 0, massWeighted = 0;
     for (std::uint64_t seed = 1; seed <= cases; ++seed) {
       const RandomCaseResult r = blockAgainstReferenceOnARandomCase(seed);
@@ -579,11 +578,6 @@ TEST(Kernel, BlockPathMatchesTheReferenceMotionOnRandomCases) {
       EXPECT_GT(r.meanMove, 1e-4) << r.description;
       substeps += r.substeps, freeFlying += r.freeFlying, wallHits += r.wallHits, capped += r.capped;
       massWeighted += r.massWeighted;
-    }
-    if (old) {
-      ::setenv("RCFD_ISA", kept.c_str(), 1);
-    } else {
-      ::unsetenv("RCFD_ISA");
     }
     // The cases took every way of moving, with both velocity interpolations.
     EXPECT_GT(massWeighted, 0);
