@@ -27,29 +27,15 @@ solve=${RCFD_SOLVE:-$(pwd)/build/rcfd-solve}
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 [ -x "$solve" ] || { echo "$0: no build; run scripts/build.sh" >&2; exit 2; }
 
+source scripts/job-lib.sh
 wants() { [[ " $stages " == *" $1 "* ]]; }
-
-# Runs one job resumably: skipped when DIR/summary.json exists, else run (or resumed) with its progress
-# lines on the terminal and everything in DIR.log.
-run_job() {
-  local name=$1 job=$2 dir=$3
-  if [ -f "$dir/summary.json" ]; then
-    echo "== $name: done ($dir/summary.json)"
-    return
-  fi
-  echo "== $name (log $dir.log)"
-  "$solve" run "$job" --out "$dir" 2>&1 | tee -a "$dir.log" | grep --line-buffered -E '%|done|error|cancelled' |
-    awk -v n="$name" '{ if (/%/) { if (NR % 20 == 1) print "   " n ": " $0 } else print "   " n ": " $0; fflush() }'
-  [ -f "$dir/summary.json" ] || { echo "$0: $name did not finish; see $dir.log" >&2; exit 1; }
-}
 
 for v in "${variants[@]}"; do
   example=$(pwd)/examples/jobs/$v-database.json
-  [ -f "$example" ] || { echo "$0: no $example" >&2; exit 2; }
-  # The example's scene file and patch, resolved against examples/jobs/ so the jobs run from OUT_DIR.
-  scene=$(cd "$(dirname "$example")" && cd "$(dirname "$(jq -r '.scene_file' "$example")")" && pwd)/$(basename "$(jq -r '.scene_file' "$example")")
+  # The example's scene file resolved against examples/jobs/, so the jobs run from OUT_DIR.
+  write_job_with_absolute_scene "$example" '{}' "$out/db-$v.json"
+  scene=$(example_scene "$example")
   patch=$(jq '.scene_patch // {}' "$example")
-  jq --arg scene "$scene" '.scene_file = $scene' "$example" > "$out/db-$v.json"
   # The rCFD jobs with the recommended tracer model (docs/calibration.md, "Velocity between cell
   # centres"): Eq. (10) with the mass-weighted velocity. The database job does not read it.
   patch=$(jq -n --argjson p "$patch" '$p * {rcfd: {velocity_interpolation: "mass_weighted"}}')
