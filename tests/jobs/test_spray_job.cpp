@@ -262,3 +262,43 @@ TEST_F(SprayJob, BadInputsExitTwoNamingTheField) {
   std::ofstream(dir_ / "bad2.json") << job.dump();
   EXPECT_NE(solve("run " + (dir_ / "bad2.json").string() + " --out " + (dir_ / "d").string()).exitCode, 0);
 }
+
+TEST_F(SprayJob, CoverageFigureDrawsSeveralRunsWithTheirSummariesStatistics) {
+  json job = json::parse(std::ifstream(dir_ / "job.json"));
+  job["duration"] = 0.2;
+  std::ofstream(dir_ / "short.json") << job.dump();
+  ASSERT_EQ(solve("run " + (dir_ / "job.json").string() + " --out " + (dir_ / "a").string()).exitCode, 0);
+  ASSERT_EQ(solve("run " + (dir_ / "short.json").string() + " --out " + (dir_ / "b").string()).exitCode, 0);
+  const fs::path svg = dir_ / "figs" / "coverage.svg";
+  const SolveResult r = solve("coverage-figure " + (dir_ / "a" / "result.h5").string() + " " +
+                              (dir_ / "b" / "result.h5").string() + " --label long --label short --out " +
+                              svg.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const json stats = json::parse(r.out);
+  ASSERT_EQ(stats.size(), 2u);
+  for (const auto& [k, dir] : {std::pair{0, "a"}, std::pair{1, "b"}}) {
+    const json c = json::parse(std::ifstream(dir_ / dir / "summary.json"))["coverage"];
+    // Quantiles exactly; the mean to round-off (result.h5 holds the tracers in id order, the summary
+    // sums them in the run's order).
+    for (const char* q : {"median", "p10", "p90"}) EXPECT_EQ(stats[k][q], c[q]) << dir << " " << q;
+    EXPECT_NEAR(stats[k]["mean"].get<double>(), c["mean"].get<double>(), 1e-12 * c["mean"].get<double>()) << dir;
+  }
+  EXPECT_EQ(stats[0]["label"], "long");
+  EXPECT_GT(stats[0]["mean"].get<double>(), stats[1]["mean"].get<double>());  // twice the spray time
+  std::ifstream in(svg);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("long: mean"), std::string::npos);
+  EXPECT_NE(text.find("short: mean"), std::string::npos);
+
+  // A file without coverage, and labels that do not match the files: exit 2 naming what is wrong.
+  const SolveResult noCoverage = solve("coverage-figure " + (dir_ / "db.h5").string() + " --out " +
+                                       (dir_ / "x.svg").string(), /*withStderr=*/true);
+  EXPECT_EQ(noCoverage.exitCode, 2);
+  EXPECT_NE(noCoverage.out.find("/coverage/per_tracer"), std::string::npos) << noCoverage.out;
+  const SolveResult labels = solve("coverage-figure " + (dir_ / "a" / "result.h5").string() + " " +
+                                   (dir_ / "b" / "result.h5").string() + " --label one --out " +
+                                   (dir_ / "y.svg").string(), /*withStderr=*/true);
+  EXPECT_EQ(labels.exitCode, 2);
+  EXPECT_NE(labels.out.find("--label"), std::string::npos) << labels.out;
+  EXPECT_FALSE(fs::exists(dir_ / "x.svg"));
+}
