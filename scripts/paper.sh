@@ -2,7 +2,8 @@
 # The paper's lab bed end to end (docs/paper-reproduction.md): for ProCell without and with draft
 # plates, the coarse-grained CFD-DEM database job (examples/jobs/VARIANT-database.json), the D0
 # calibration against its reference period (the paper's 35 s per D0, 5 s discarded), and one hour of
-# spray at the selected D0 with the scene's 472,850 tracers; then a table of what each gives.
+# spray at the selected D0 with the scene's 472,850 tracers; then a table of what each gives and the
+# beds' coverage distributions in one figure (OUT_DIR/coverage.svg, the paper's Fig. 12).
 #   bash scripts/paper.sh OUT_DIR [VARIANT ...]
 # VARIANT: procell-coarse-grained (no plates) and procell-coarse-grained-draft-plates (default: both).
 # Resumable: run it again with the same OUT_DIR; finished jobs are kept, interrupted ones resume from
@@ -76,3 +77,15 @@ for v in "${variants[@]}"; do
     awk -F'\t' '{printf "%-38s %-9s %-8s %-9s %-8s %-7s %-9s %-8s %-8s %-8s %-8s %s\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12}'
 done
 echo "(holdup, mean stay, crossing rate against the database's reference period; KS of the stays; coverage after the spray)"
+
+# The paper's Fig. 12: the beds' coverage distributions in one figure, once their sprays are done.
+results=() labels=()
+for v in "${variants[@]}"; do
+  [ -f "$out/spray-$v/result.h5" ] || continue
+  results+=("$out/spray-$v/result.h5")
+  labels+=(--label "$v")
+done
+if [ ${#results[@]} -gt 0 ]; then
+  "$solve" coverage-figure "${results[@]}" "${labels[@]}" --out "$out/coverage.svg" > "$out/coverage.json"
+  echo "coverage distributions: $out/coverage.svg (statistics in $out/coverage.json)"
+fi
