@@ -78,6 +78,24 @@ for v in "${variants[@]}"; do
 done
 echo "(holdup, mean stay, crossing rate against the database's reference period; KS of the stays; coverage after the spray)"
 
+# The beds compared (the paper's plates-versus-no-plates findings): the spray-zone holdup and mean stay
+# of the tracers over the hour against the full simulation's reference period, the overspray of the hour
+# against the reference period's recorded spray, and the coverage spread.
+echo
+printf '%-38s %-17s %-15s %-17s %-8s %-8s %s\n' bed 'holdup rCFD/ref' 'stay s rCFD/ref' 'overspray rCFD/ref' \
+  median p10 'p90 (p90-p10)'
+for v in "${variants[@]}"; do
+  db=$out/db-$v/summary.json spray=$out/spray-$v/summary.json
+  [ -f "$db" ] && [ -f "$spray" ] || continue
+  jq -r --slurpfile ref "$db" --arg v "$v" 'def r(k): . * k | round / k | tostring; $ref[0] as $d |
+    [$v, (.holdup.mean | r(1)) + "/" + ($d.holdup.mean | r(1)),
+     (.residence_time.mean_s | r(1000)) + "/" + ($d.residence_time.mean_s | r(1000)),
+     (.overspray_fraction | r(10000)) + "/" + ($d.reference_coverage.overspray_fraction // null | if . == null then "n/a" else r(10000) end),
+     (.coverage.median | r(1000)), (.coverage.p10 | r(1000)),
+     (.coverage.p90 | r(1000)) + " (" + (.coverage.p90 - .coverage.p10 | r(1000)) + ")"] | @tsv' "$spray" |
+    awk -F'\t' '{printf "%-38s %-17s %-15s %-17s %-8s %-8s %s\n", $1, $2, $3, $4, $5, $6, $7}'
+done
+
 # The paper's Fig. 12: the beds' coverage distributions in one figure, once their sprays are done.
 results=() labels=()
 for v in "${variants[@]}"; do
