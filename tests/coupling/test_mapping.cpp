@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <omp.h>
 #include <random>
 
 #include "CouplingTestSupport.hpp"
@@ -60,6 +61,32 @@ TEST(VolumeMapping, ConservesTheTotalParticleVolumeAndAvoidsClosedCells) {
   double back = 0.0;
   for (std::size_t c = 0; c < a.size(); ++c) back += a[c] * m.mapping.openVolume(c);
   EXPECT_NEAR(back, total, 1e-13 * total);
+}
+
+TEST(VolumeMapping, TheParallelGatherIsTheSerialScatterToTheBit) {
+  SliceMapping m;
+  // More parcels than the parallel threshold, so the contributions are counted in chunks.
+  test::scatterParcels(m.dem, m.apparatus, 6000, m.dem.material().particle_radius, 11, 0.3);
+  ASSERT_GE(long(m.dem.particles().size()), coupling::kParallelParcels);
+  std::vector<KernelWeights> w;
+  std::vector<double> serial;
+  m.mapping.weightsOf(m.dem.particles(), w);
+  m.mapping.scatterVolume(m.dem.particles(), w, serial);
+  const int threads = omp_get_max_threads();
+  for (int t : {1, 2, 3}) {
+    omp_set_num_threads(t);
+    coupling::CellContributions c;
+    std::vector<double> gathered;
+    m.mapping.contributionsOf(w, c);
+    m.mapping.gatherVolume(m.dem.particles(), c, gathered);
+    ASSERT_EQ(gathered.size(), serial.size());
+    for (std::size_t cell = 0; cell < serial.size(); ++cell) {
+      EXPECT_EQ(gathered[cell], serial[cell]) << "cell " << cell << ", " << t << " threads";
+      for (auto e = c.start[cell] + 1; e < c.start[cell + 1]; ++e)
+        EXPECT_LT(c.parcel[std::size_t(e) - 1], c.parcel[std::size_t(e)]) << "cell " << cell;
+    }
+  }
+  omp_set_num_threads(threads);
 }
 
 TEST(VolumeMapping, SmoothInsideACellAndExactForAParcelOnACentre) {

@@ -7,12 +7,6 @@
 
 namespace rcfd::coupling {
 
-namespace {
-
-/// Cells per parallel sweep below which one thread is faster (the quick slice has 24,000).
-constexpr std::size_t kParallelCells = 8192;
-
-}  // namespace
 
 FieldSmoother::FieldSmoother(const VolumeMapping& mapping, const std::vector<char>& open0,
                              const std::vector<char>& open1, const std::vector<char>& open2, double length)
@@ -120,14 +114,18 @@ void FieldSmoother::smoothImpl(std::vector<T>& gamma) const {
     field[std::size_t(q)] = planes.data() + std::size_t(q) * padded;
     spare[std::size_t(q)] = planes.data() + std::size_t(K + q) * padded;
   }
+  const bool parallel = cells_ >= std::size_t(kParallelCells);
+  const long cells = long(cells_);
   const double* src = reinterpret_cast<const double*>(gamma.data());
-  for (std::size_t c = 0; c < cells_; ++c)
-    for (int q = 0; q < K; ++q) field[std::size_t(q)][pad_ + c] = src[c * K + q];
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long c = 0; c < cells; ++c)
+    for (int q = 0; q < K; ++q) field[std::size_t(q)][pad_ + std::size_t(c)] = src[std::size_t(c) * K + q];
   gatherSweeps<K>(field, spare, {g_[0].data(), g_[1].data(), g_[2].data()}, invVolume_.data(), stride_[1],
-                  stride_[2], pad_, pad_ + cells_, subSteps_, cells_ >= kParallelCells);
+                  stride_[2], pad_, pad_ + cells_, subSteps_, parallel);
   double* dst = reinterpret_cast<double*>(gamma.data());
-  for (std::size_t c = 0; c < cells_; ++c)
-    for (int q = 0; q < K; ++q) dst[c * K + q] = field[std::size_t(q)][pad_ + c];
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long c = 0; c < cells; ++c)
+    for (int q = 0; q < K; ++q) dst[std::size_t(c) * K + q] = field[std::size_t(q)][pad_ + std::size_t(c)];
 }
 
 void FieldSmoother::smooth(std::vector<double>& gamma) const { smoothImpl(gamma); }

@@ -52,8 +52,12 @@ std::vector<double> FluidCoupling::currentFraction(bool smoothed) const {
 void FluidCoupling::prepare(double interval) {
   const DemParticles& p = dem_.particles();
   const std::size_t n = p.size(), cells = alphaP_.size();
+  const long lc = long(cells), ln = long(n);
+  const bool parallelCells = lc >= kParallelCells;
   mapping_->weightsOf(p, weights_);
-  mapping_->scatterVolume(p, weights_, volume_);
+  // The scatters below gather per cell in parcel order: the serial scatter's sums on any thread count.
+  mapping_->contributionsOf(weights_, contributions_);
+  mapping_->gatherVolume(p, contributions_, volume_);
   // The drag closure sees the parcel's own surroundings: the mapped (unsmoothed) packing, with the
   // over-packing redistribution. Smoothing is a device for the gas equations (Eq. 3, "to ensure
   // stability"); a smoothed packing in F(eps, Re), which is convex in alpha_P, would take drag away
@@ -61,32 +65,46 @@ void FluidCoupling::prepare(double interval) {
   localVolume_ = volume_;
   mapping_->redistributeExcess(localVolume_, options_.maxParticleFraction);
   localAlphaG_ = mapping_->fractionOf(localVolume_);
-  for (std::size_t c = 0; c < cells; ++c) localAlphaG_[c] = 1.0 - localAlphaG_[c];
+#pragma omp parallel for schedule(static) if (parallelCells)
+  for (long c = 0; c < lc; ++c) localAlphaG_[std::size_t(c)] = 1.0 - localAlphaG_[std::size_t(c)];
   if (smoother_) {
-    for (std::size_t c = 0; c < cells; ++c)
+#pragma omp parallel for schedule(static) if (parallelCells)
+    for (long lcell = 0; lcell < lc; ++lcell) {
+      const std::size_t c = std::size_t(lcell);
       alphaP_[c] = mapping_->usable()[c] ? volume_[c] / mapping_->openVolume(c) : 0.0;
+    }
     smoother_->smooth(alphaP_);
-    for (std::size_t c = 0; c < cells; ++c) volume_[c] = alphaP_[c] * mapping_->openVolume(c);
+#pragma omp parallel for schedule(static) if (parallelCells)
+    for (long c = 0; c < lc; ++c)
+      volume_[std::size_t(c)] = alphaP_[std::size_t(c)] * mapping_->openVolume(std::size_t(c));
   }
   redistributed_ = mapping_->redistributeExcess(volume_, options_.maxParticleFraction);
   alphaP_ = mapping_->fractionOf(volume_);
-  for (std::size_t c = 0; c < cells; ++c) {
+  long firstTooDense = lc;
+#pragma omp parallel for schedule(static) reduction(min : firstTooDense) if (parallelCells)
+  for (long lcell = 0; lcell < lc; ++lcell) {
+    const std::size_t c = std::size_t(lcell);
     alphaG_[c] = mapping_->usable()[c] ? 1.0 - alphaP_[c] : 1.0;
-    if (!(alphaG_[c] >= kMinGasFraction)) {
-      const auto ijk = gas_.grid().cellIjk(std::int64_t(c));
-      std::ostringstream s;
-      s << "coupling: alpha_P = " << alphaP_[c] << " in cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2]
-        << ") at t = " << dem_.time() << " s after the over-packing redistribution (limit "
-        << options_.maxParticleFraction << "): the cell has no open neighbour to take the excess";
-      throw RunError(s.str());
-    }
+    if (!(alphaG_[c] >= kMinGasFraction)) firstTooDense = std::min(firstTooDense, lcell);
+  }
+  if (firstTooDense < lc) {
+    const std::size_t c = std::size_t(firstTooDense);
+    const auto ijk = gas_.grid().cellIjk(std::int64_t(c));
+    std::ostringstream s;
+    s << "coupling: alpha_P = " << alphaP_[c] << " in cell (" << ijk[0] << ", " << ijk[1] << ", " << ijk[2]
+      << ") at t = " << dem_.time() << " s after the over-packing redistribution (limit "
+      << options_.maxParticleFraction << "): the cell has no open neighbour to take the excess";
+    throw RunError(s.str());
   }
   // dalpha_G/dt as a backward difference over the interval in which the parcels moved (the previous
   // coupling step), not over the coming gas step: the two differ whenever a step is cut short (to hit
   // a sampling instant) and the gas would see the change at the wrong rate (pressure spikes).
   std::vector<double> rate(cells, 0.0);
-  if (!first_ && interval > 0)
-    for (std::size_t c = 0; c < cells; ++c) rate[c] = (alphaG_[c] - gas_.gasFractionOf(c)) / interval;
+  if (!first_ && interval > 0) {
+#pragma omp parallel for schedule(static) if (parallelCells)
+    for (long c = 0; c < lc; ++c)
+      rate[std::size_t(c)] = (alphaG_[std::size_t(c)] - gas_.gasFractionOf(std::size_t(c))) / interval;
+  }
   gas_.setGasFraction(alphaG_, rate);
   first_ = false;
 
@@ -100,8 +118,7 @@ void FluidCoupling::prepare(double interval) {
     const double cg = scene_.dem.coarse_graining, d = scene_.particles.diameter;
     const double nu = scene_.gas.kinematic_viscosity, mu = scene_.gas.density * nu;
     const double stokes = cg * cg * cg * 3.0 * std::numbers::pi * mu * d;
-    const long ln = long(n);
-#pragma omp parallel for schedule(static) if (ln >= 4096)
+#pragma omp parallel for schedule(static) if (ln >= kParallelParcels)
     for (long li = 0; li < ln; ++li) {
       const std::size_t i = std::size_t(li);
       const double eps = VolumeMapping::interpolate(localAlphaG_, weights_[i]);
@@ -109,18 +126,24 @@ void FluidCoupling::prepare(double interval) {
       const double re = d * eps * slip.norm() / nu;
       k_[i] = stokes * eps * model_->normalisedDrag(eps, re);  // K_i [kg/s]
     }
-    // (beta, beta u_P) per cell in one array: scattered, smoothed, split.
-    std::vector<Eigen::Vector4d> bk(cells, Eigen::Vector4d::Zero());
-    for (std::size_t i = 0; i < n; ++i)  // serial scatter in index order: deterministic
-      for (int q = 0; q < weights_[i].count; ++q) {
-        const std::size_t c = std::size_t(weights_[i].cell[std::size_t(q)]);
-        const double wk = weights_[i].w[std::size_t(q)] * k_[i];
-        bk[c] += wk * Eigen::Vector4d(1.0, p.v[i].x(), p.v[i].y(), p.v[i].z());
+    // (beta, beta u_P) per cell in one array: gathered in parcel order, smoothed, split.
+    std::vector<Eigen::Vector4d> bk(cells);
+    const CellContributions& e = contributions_;
+#pragma omp parallel for schedule(static) if (parallelCells)
+    for (long lcell = 0; lcell < lc; ++lcell) {
+      const std::size_t c = std::size_t(lcell);
+      Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+      for (std::int32_t q = e.start[c]; q < e.start[c + 1]; ++q) {
+        const std::size_t i = std::size_t(e.parcel[std::size_t(q)]);
+        const double wk = e.weight[std::size_t(q)] * k_[i];
+        sum += wk * Eigen::Vector4d(1.0, p.v[i].x(), p.v[i].y(), p.v[i].z());
       }
-    for (std::size_t c = 0; c < cells; ++c)
-      if (mapping_->usable()[c]) bk[c] /= mapping_->openVolume(c);
+      bk[c] = mapping_->usable()[c] ? Eigen::Vector4d(sum / mapping_->openVolume(c)) : sum;
+    }
     if (smoother_) smoother_->smooth(bk);
-    for (std::size_t c = 0; c < cells; ++c) {
+#pragma omp parallel for schedule(static) if (parallelCells)
+    for (long lcell = 0; lcell < lc; ++lcell) {
+      const std::size_t c = std::size_t(lcell);
       beta_[c] = bk[c][0];
       uP_[c] = beta_[c] > 0 ? Eigen::Vector3d(bk[c].tail<3>() / beta_[c]) : Eigen::Vector3d::Zero();
     }
@@ -138,7 +161,7 @@ void FluidCoupling::applyForces() {
   seenValid_ = options_.drag;
   const std::vector<Eigen::Vector3d>& u = uSeen_;
   const long ln = long(n);
-#pragma omp parallel for schedule(static) if (ln >= 4096)
+#pragma omp parallel for schedule(static) if (ln >= kParallelParcels)
   for (long li = 0; li < ln; ++li) {
     const std::size_t i = std::size_t(li);
     Eigen::Vector3d f = Eigen::Vector3d::Zero();

@@ -80,6 +80,7 @@ class FluidCoupling {
   std::unique_ptr<VolumeMapping> mapping_;
   std::unique_ptr<FieldSmoother> smoother_;
   std::vector<KernelWeights> weights_;
+  CellContributions contributions_;  ///< weights_ by cell (the deterministic parallel scatters)
   std::vector<double> volume_, alphaP_, alphaG_, beta_, k_;
   std::vector<double> localVolume_, localAlphaG_;  ///< unsmoothed packing for the drag closure
   std::vector<Eigen::Vector3d> uP_, drag_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <exception>
 #include <cmath>
+#include <omp.h>
 #include <sstream>
 
 #include "core/Errors.hpp"
@@ -124,6 +125,57 @@ void VolumeMapping::scatterVolume(const DemParticles& p, const std::vector<Kerne
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double v = parcelVolume(p, i);
     for (int k = 0; k < w[i].count; ++k) volume[std::size_t(w[i].cell[std::size_t(k)])] += w[i].w[std::size_t(k)] * v;
+  }
+}
+
+void VolumeMapping::contributionsOf(const std::vector<KernelWeights>& w, CellContributions& out) const {
+  const std::size_t cells = phi_.size();
+  const long n = long(w.size());
+  const int chunks = n >= kParallelParcels ? omp_get_max_threads() : 1;
+  // counts[k * cells + c]: entries of chunk k in cell c, then where chunk k writes its next one there.
+  std::vector<std::int32_t> counts(std::size_t(chunks) * cells, 0);
+  out.start.resize(cells + 1);
+#pragma omp parallel num_threads(chunks) if (chunks > 1)
+  {
+    const int k = omp_get_thread_num();
+    const long i0 = n * k / chunks, i1 = n * (k + 1) / chunks;
+    std::int32_t* mine = counts.data() + std::size_t(k) * cells;
+    for (long i = i0; i < i1; ++i)
+      for (int q = 0; q < w[std::size_t(i)].count; ++q) ++mine[w[std::size_t(i)].cell[std::size_t(q)]];
+#pragma omp barrier
+#pragma omp single
+    {
+      std::int32_t running = 0;
+      for (std::size_t c = 0; c < cells; ++c) {
+        out.start[c] = running;
+        for (int j = 0; j < chunks; ++j) {
+          const std::int32_t here = counts[std::size_t(j) * cells + c];
+          counts[std::size_t(j) * cells + c] = running;
+          running += here;
+        }
+      }
+      out.start[cells] = running;
+      out.parcel.resize(std::size_t(running));
+      out.weight.resize(std::size_t(running));
+    }  // (single's barrier: every chunk's offsets are set before any chunk writes)
+    for (long i = i0; i < i1; ++i)
+      for (int q = 0; q < w[std::size_t(i)].count; ++q) {
+        const std::int32_t e = mine[w[std::size_t(i)].cell[std::size_t(q)]]++;
+        out.parcel[std::size_t(e)] = std::int32_t(i);
+        out.weight[std::size_t(e)] = w[std::size_t(i)].w[std::size_t(q)];
+      }
+  }
+}
+
+void VolumeMapping::gatherVolume(const DemParticles& p, const CellContributions& c, std::vector<double>& volume) const {
+  const long cells = long(phi_.size());
+  volume.resize(std::size_t(cells));
+#pragma omp parallel for schedule(static) if (cells >= kParallelCells)
+  for (long cell = 0; cell < cells; ++cell) {
+    double v = 0.0;
+    for (std::int32_t e = c.start[std::size_t(cell)]; e < c.start[std::size_t(cell) + 1]; ++e)
+      v += c.weight[std::size_t(e)] * parcelVolume(p, std::size_t(c.parcel[std::size_t(e)]));
+    volume[std::size_t(cell)] = v;
   }
 }
 

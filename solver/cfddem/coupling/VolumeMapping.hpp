@@ -28,6 +28,20 @@ struct KernelWeights {
   int count = 0;
 };
 
+/// Below these sizes an OpenMP team costs the coupling's loops more than it saves.
+inline constexpr long kParallelParcels = 4096;
+inline constexpr long kParallelCells = 8192;
+
+/// The kernel weights regrouped by cell: for every cell the parcels whose weights point into it, with
+/// those weights, in parcel order. A sum over a cell's entries adds the parcels' contributions in the
+/// order a serial scatter over the parcels does, so a gather parallel over the cells gives the serial
+/// scatter's bits for any number of threads.
+struct CellContributions {
+  std::vector<std::int32_t> start;   ///< entries of cell c: [start[c], start[c + 1])
+  std::vector<std::int32_t> parcel;  ///< per entry: the parcel's index
+  std::vector<double> weight;        ///< per entry: the parcel's weight in the cell
+};
+
 /// Over-packing limit: alpha_P of a cell's open volume above this after mapping (and smoothing) is
 /// moved to the neighbouring open cells (VolumeMapping::redistributeExcess). Above random close
 /// packing (0.64) so a resolved dense bed is untouched; mapped peaks near walls beyond it are a kernel
@@ -48,8 +62,14 @@ class VolumeMapping {
   /// Weights of every parcel (index order).
   void weightsOf(const DemParticles& p, std::vector<KernelWeights>& out) const;
 
-  /// Particle volume per cell [m3] (serial scatter in index order: deterministic).
+  /// Particle volume per cell [m3] (serial scatter in index order: deterministic). The plain path beside
+  /// gatherVolume().
   void scatterVolume(const DemParticles& p, const std::vector<KernelWeights>& w, std::vector<double>& volume) const;
+  /// The weights by cell (a counting sort, parallel over chunks of parcels; the result does not depend on
+  /// the chunks).
+  void contributionsOf(const std::vector<KernelWeights>& w, CellContributions& out) const;
+  /// scatterVolume()'s result to the bit, gathered per cell in parallel.
+  void gatherVolume(const DemParticles& p, const CellContributions& c, std::vector<double>& volume) const;
 
   /// alpha_P of the open volume from a volume per cell [-] (0 in unusable cells).
   std::vector<double> fractionOf(const std::vector<double>& volume) const;
