@@ -62,7 +62,7 @@ for c in "${selected[@]}"; do
   jq -r --arg c "$c" 'def r(k): . * k | round / k;
     [$c, (.holdup.mean | r(10)), (.residence_time.mean_s | r(1000)), (.residence_time.median_s | r(1000)),
      (.periods.stays.reference_period.crossings_per_member_per_s // null | if . == null then "n/a" else r(10000) end),
-     (.reference_coverage.overspray_fraction // null | if . == null then "n/a" else (. * 100 | r(10000)) + "%" end),
+     (.reference_coverage.overspray_fraction // null | if . == null then "n/a" else (. * 100 | r(10000) | tostring) + "%" end),
      (.reference_coverage.mean // null | if . == null then "n/a" else r(100000) end),
      (.reference_coverage.p10 // null | if . == null then "n/a" else r(100000) end),
      (.reference_coverage.p90 // null | if . == null then "n/a" else r(100000) end),
