@@ -2,6 +2,7 @@
 #include "cfddem/DemParallel.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <omp.h>
 
@@ -110,7 +111,9 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
   for (long i = 0; i < n; ++i) {
     long c[3];
     cellOf(p.x[i], c);
-    cell_of[i] = static_cast<Index>((c[2] * nc[1] + c[1]) * nc[0] + c[0]);
+    // y slowest, then z, then x: the order sortParticles() keeps the particles in, so a block of cells
+    // reads neighbouring memory.
+    cell_of[i] = static_cast<Index>((c[1] * nc[2] + c[2]) * nc[0] + c[0]);
     ++cell_start_[cell_of[i] + 1];
   }
   for (long c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
@@ -119,64 +122,96 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
     for (long i = 0; i < n; ++i) cell_particles_[fill[cell_of[i]]++] = static_cast<Index>(i);
   }
 
-  // Two passes over the same stencil: count, then fill (parallel, results independent of threads).
-  auto visit = [&](long i, auto&& emit) {
-    long c[3];
-    cellOf(p.x[i], c);
-    const Vector3d xi = p.x[i];
-    const double ri = p.radius[i];
-    for (long dz = -1; dz <= 1; ++dz) {
-      const long z = c[2] + dz;
-      if (z < 0 || z >= nc[2]) continue;
-      for (long dy = -1; dy <= 1; ++dy) {
-        const long y = c[1] + dy;
-        if (y < 0 || y >= nc[1]) continue;
-        for (long dx = -1; dx <= 1; ++dx) {
-          const long x = c[0] + dx;
-          if (x < 0 || x >= nc[0]) continue;
-          const long cc = (z * nc[1] + y) * nc[0] + x;
-          for (Index q = cell_start_[cc]; q < cell_start_[cc + 1]; ++q) {
-            const Index k = cell_particles_[q];
-            if (k <= static_cast<Index>(i)) continue;
-            const double cut = ri + p.radius[k] + skin_;
-            if ((p.x[k] - xi).squaredNorm() < cut * cut) emit(k);
-          }
+  // Each pair is met once: a particle meets the particles after it in its own cell and every particle of
+  // the 13 neighbour cells after its cell (the half of the 26 whose first non-zero offset, in the cells'
+  // y, z, x order, is positive). Cells go in fixed blocks, each block's pairs (lower index first) into a buffer
+  // of its own.
+  static constexpr long kForward[13][3] = {{0, 0, 1},  {0, 1, -1}, {0, 1, 0},  {0, 1, 1},  {1, -1, -1},
+                                           {1, -1, 0}, {1, -1, 1}, {1, 0, -1}, {1, 0, 0},  {1, 0, 1},
+                                           {1, 1, -1}, {1, 1, 0},  {1, 1, 1}};
+  constexpr long kCellsPerBlock = 512;
+  const long cellBlocks = (ncell + kCellsPerBlock - 1) / kCellsPerBlock;
+  std::vector<std::vector<std::array<Index, 2>>> found(static_cast<std::size_t>(cellBlocks));
+  const bool parallel = n >= kDemParallelMinParticles;
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+  for (long b = 0; b < cellBlocks; ++b) {
+    auto& out = found[std::size_t(b)];
+    for (long cc = b * kCellsPerBlock; cc < std::min(ncell, (b + 1) * kCellsPerBlock); ++cc) {
+      const Index first = cell_start_[cc], last = cell_start_[cc + 1];
+      if (first == last) continue;
+      const long x = cc % nc[0], z = (cc / nc[0]) % nc[2], y = cc / (nc[0] * nc[2]);
+      for (Index qa = first; qa < last; ++qa) {
+        const Index a = cell_particles_[qa];
+        const Vector3d xa = p.x[a];
+        const double ra = p.radius[a];
+        auto meet = [&](Index k) {
+          const double cut = ra + p.radius[k] + skin_;
+          if ((p.x[k] - xa).squaredNorm() < cut * cut) out.push_back(a < k ? std::array<Index, 2>{a, k} : std::array<Index, 2>{k, a});
+        };
+        for (Index qb = qa + 1; qb < last; ++qb) meet(cell_particles_[qb]);
+        for (const auto& o : kForward) {
+          const long yy = y + o[0], zz = z + o[1], xx = x + o[2];
+          if (yy >= nc[1] || zz < 0 || zz >= nc[2] || xx < 0 || xx >= nc[0]) continue;
+          const long nb = (yy * nc[2] + zz) * nc[0] + xx;
+          for (Index qb = cell_start_[nb]; qb < cell_start_[nb + 1]; ++qb) meet(cell_particles_[qb]);
         }
       }
     }
-  };
-  // One pass over the stencil in fixed blocks of rows, each into its own buffer, then the buffers
-  // joined in block order: the same list for any number of threads.
+  }
+  // Rows: the pairs counted by their lower index (each thread a contiguous range of blocks), placed,
+  // and each row sorted: a fixed order whatever the cells and threads, and a cheap history look-up.
+  const int teams = parallel ? omp_get_max_threads() : 1;
+  std::vector<Index> counts(std::size_t(teams) * std::size_t(n), 0);
+  std::vector<Index> next_j;
+#pragma omp parallel num_threads(teams) if (teams > 1)
+  {
+    const int t = omp_get_thread_num();
+    const long b0 = cellBlocks * t / teams, b1 = cellBlocks * (t + 1) / teams;
+    Index* mine = counts.data() + std::size_t(t) * std::size_t(n);
+    for (long b = b0; b < b1; ++b)
+      for (const auto& pr : found[std::size_t(b)]) ++mine[pr[0]];
+#pragma omp barrier
+#pragma omp single
+    {
+      Index running = 0;
+      for (long i = 0; i < n; ++i) {
+        row_start[i] = running;
+        for (int u = 0; u < teams; ++u) {
+          const Index here = counts[std::size_t(u) * std::size_t(n) + std::size_t(i)];
+          counts[std::size_t(u) * std::size_t(n) + std::size_t(i)] = running;
+          running += here;
+        }
+      }
+      row_start[n] = running;
+      next_j.resize(running);
+    }
+    for (long b = b0; b < b1; ++b)
+      for (const auto& pr : found[std::size_t(b)]) next_j[mine[pr[0]]++] = pr[1];
+#pragma omp barrier
+#pragma omp for schedule(static)
+    for (long i = 0; i < n; ++i) std::sort(next_j.begin() + row_start[i], next_j.begin() + row_start[i + 1]);
+  }
+  // Wall candidates per particle, in fixed blocks of particles joined in block order.
   constexpr long kRowsPerBlock = 256;
   const long blocks = (n + kRowsPerBlock - 1) / kRowsPerBlock;
-  std::vector<std::vector<Index>> blockPairs(static_cast<std::size_t>(blocks)), blockWalls(static_cast<std::size_t>(blocks));
-#pragma omp parallel for schedule(dynamic, 1) if (n >= kDemParallelMinParticles)
+  std::vector<std::vector<Index>> blockWalls(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
   for (long b = 0; b < blocks; ++b) {
-    auto& pairs = blockPairs[std::size_t(b)];
     auto& wallsNear = blockWalls[std::size_t(b)];
     for (long i = b * kRowsPerBlock; i < std::min(n, (b + 1) * kRowsPerBlock); ++i) {
-      const std::size_t first = pairs.size();
-      visit(i, [&](Index k) { pairs.push_back(k); });
-      // Sorted rows: a fixed order whatever the cell layout, and a cheap history look-up.
-      std::sort(pairs.begin() + std::ptrdiff_t(first), pairs.end());
-      row_start[i + 1] = static_cast<Index>(pairs.size() - first);
       const std::size_t firstWall = wallsNear.size();
       for (std::size_t k = 0; k < walls.size(); ++k)
         if (walls.distanceTo(k, p.x[i]) < p.radius[i] + skin_) wallsNear.push_back(static_cast<Index>(k));
       wall_start[i + 1] = static_cast<Index>(wallsNear.size() - firstWall);
     }
   }
-  for (long i = 0; i < n; ++i) {
-    row_start[i + 1] += row_start[i];
-    wall_start[i + 1] += wall_start[i];
-  }
-  j.resize(row_start[n]);
+  for (long i = 0; i < n; ++i) wall_start[i + 1] += wall_start[i];
+  j = std::move(next_j);
   shear.assign(row_start[n], Vector3d::Zero());
   wall_id.resize(wall_start[n]);
-#pragma omp parallel for schedule(dynamic, 1) if (n >= kDemParallelMinParticles)
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
   for (long b = 0; b < blocks; ++b) {
     const long i0 = b * kRowsPerBlock, i1 = std::min(n, (b + 1) * kRowsPerBlock);
-    std::copy(blockPairs[std::size_t(b)].begin(), blockPairs[std::size_t(b)].end(), j.begin() + row_start[i0]);
     std::copy(blockWalls[std::size_t(b)].begin(), blockWalls[std::size_t(b)].end(), wall_id.begin() + wall_start[i0]);
     for (long i = i0; i < std::min(i1, old_n); ++i) {
       Index o = old_start[i];

@@ -10,6 +10,7 @@
 #include "ProCellSection.hpp"
 #include "cfddem/ApparatusWalls.hpp"
 #include "cfddem/DemFilling.hpp"
+#include "cfddem/DemParallel.hpp"
 #include "core/Errors.hpp"
 
 namespace rcfd {
@@ -247,29 +248,37 @@ std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> pairsWithinRe
 TEST(NeighbourList, ListsExactlyThePairsWithinReachHoweverLargeTheBoxAroundThem) {
   // A dense cluster in a tall box with a sparse fountain above it (fine linked cells, tens per
   // particle), then the same with two particles escaped 1 km away (cells coarsened to fit): the list
-  // holds exactly the pairs a brute-force search finds, each row sorted.
+  // holds exactly the pairs a brute-force search finds, each row sorted, on one thread and on the
+  // parallel path (more particles than kDemParallelMinParticles) with two and three.
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double r = 1e-3, skin = 0.4 * r;
   DemParticles p;
-  for (int i = 0; i < 1500; ++i) p.add(Vector3d(0.03 * u(rng), 0.03 * u(rng), 0.01 * u(rng)), Vector3d::Zero(), r * (0.8 + 0.4 * u(rng)), 1000.0);
+  for (int i = 0; i < 3000; ++i) p.add(Vector3d(0.04 * u(rng), 0.04 * u(rng), 0.01 * u(rng)), Vector3d::Zero(), r * (0.8 + 0.4 * u(rng)), 1000.0);
+  ASSERT_GE(long(p.size()), kDemParallelMinParticles);
+  const int threads = omp_get_max_threads();
   for (int i = 0; i < 100; ++i) p.add(Vector3d(0.03 * u(rng), 0.03 + 0.5 * u(rng), 0.01 * u(rng)), Vector3d::Zero(), r, 1000.0);
   for (const bool escaped : {false, true}) {
     if (escaped) {
       p.add(Vector3d(1000.0, 0.0, 0.0), Vector3d::Zero(), r, 1000.0);
       p.add(Vector3d(0.0, -1000.0, 1000.0), Vector3d::Zero(), r, 1000.0);
     }
-    NeighbourList list(skin);
-    list.build(p, DemWalls());
-    std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> listed;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      for (auto q = list.row_start[i]; q < list.row_start[i + 1]; ++q) {
-        if (q > list.row_start[i]) EXPECT_LT(list.j[q - 1], list.j[q]);
-        listed.emplace_back(NeighbourList::Index(i), list.j[q]);
-      }
     const auto expected = pairsWithinReach(p, skin);
     EXPECT_GT(expected.size(), 1000u);
-    EXPECT_EQ(listed, expected) << (escaped ? "with particles far away" : "a bed and a fountain");
+    for (int t : {1, 2, 3}) {
+      omp_set_num_threads(t);
+      NeighbourList list(skin);
+      list.build(p, DemWalls());
+      std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> listed;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        for (auto q = list.row_start[i]; q < list.row_start[i + 1]; ++q) {
+          if (q > list.row_start[i]) EXPECT_LT(list.j[q - 1], list.j[q]);
+          listed.emplace_back(NeighbourList::Index(i), list.j[q]);
+        }
+      EXPECT_EQ(listed, expected) << (escaped ? "with particles far away" : "a bed and a fountain") << ", "
+                                  << t << " threads";
+    }
+    omp_set_num_threads(threads);
   }
 }
 
