@@ -272,7 +272,9 @@ TEST(NeighbourList, ListsExactlyThePairsWithinReachHoweverLargeTheBoxAroundThem)
       std::vector<std::pair<NeighbourList::Index, NeighbourList::Index>> listed;
       for (std::size_t i = 0; i < p.size(); ++i)
         for (auto q = list.row_start[i]; q < list.row_start[i + 1]; ++q) {
-          if (q > list.row_start[i]) EXPECT_LT(list.j[q - 1], list.j[q]);
+          if (q > list.row_start[i]) {
+            EXPECT_LT(list.j[q - 1], list.j[q]);
+          }
           listed.emplace_back(NeighbourList::Index(i), list.j[q]);
         }
       EXPECT_EQ(listed, expected) << (escaped ? "with particles far away" : "a bed and a fountain") << ", "
