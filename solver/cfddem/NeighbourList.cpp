@@ -165,8 +165,9 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
   std::vector<Index> next_j;
 #pragma omp parallel num_threads(teams) if (teams > 1)
   {
-    const int t = omp_get_thread_num();
-    const long b0 = cellBlocks * t / teams, b1 = cellBlocks * (t + 1) / teams;
+    // The team may be smaller than asked (inside another parallel region): its own size splits the work.
+    const int team = omp_get_num_threads(), t = omp_get_thread_num();
+    const long b0 = cellBlocks * t / team, b1 = cellBlocks * (t + 1) / team;
     Index* mine = counts.data() + std::size_t(t) * std::size_t(n);
     for (long b = b0; b < b1; ++b)
       for (const auto& pr : found[std::size_t(b)]) ++mine[pr[0]];
@@ -176,7 +177,7 @@ void NeighbourList::build(const DemParticles& p, const DemWalls& walls) {
       Index running = 0;
       for (long i = 0; i < n; ++i) {
         row_start[i] = running;
-        for (int u = 0; u < teams; ++u) {
+        for (int u = 0; u < team; ++u) {
           const Index here = counts[std::size_t(u) * std::size_t(n) + std::size_t(i)];
           counts[std::size_t(u) * std::size_t(n) + std::size_t(i)] = running;
           running += here;

@@ -87,6 +87,21 @@ TEST(VolumeMapping, TheParallelGatherIsTheSerialScatterToTheBit) {
     }
   }
   omp_set_num_threads(threads);
+  // Inside another parallel region without nesting the team is one thread, whatever
+  // omp_get_max_threads() says: every parcel is still counted.
+  const int levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(1);
+  std::vector<double> inner;
+#pragma omp parallel num_threads(2)
+  {
+    coupling::CellContributions c;
+    std::vector<double> gathered;
+    m.mapping.contributionsOf(w, c);
+    m.mapping.gatherVolume(m.dem.particles(), c, gathered);
+    if (omp_get_thread_num() == 0) inner = gathered;
+  }
+  omp_set_max_active_levels(levels);
+  EXPECT_EQ(inner, serial);
 }
 
 TEST(VolumeMapping, SmoothInsideACellAndExactForAParcelOnACentre) {

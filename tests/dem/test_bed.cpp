@@ -281,6 +281,19 @@ TEST(NeighbourList, ListsExactlyThePairsWithinReachHoweverLargeTheBoxAroundThem)
                                   << t << " threads";
     }
     omp_set_num_threads(threads);
+    // Inside another parallel region without nesting (a team of one whatever omp_get_max_threads()
+    // says) the list is the same.
+    const int levels = omp_get_max_active_levels();
+    omp_set_max_active_levels(1);
+    std::size_t innerPairs = 0;
+#pragma omp parallel num_threads(2)
+    {
+      NeighbourList list(skin);
+      list.build(p, DemWalls());
+      if (omp_get_thread_num() == 0) innerPairs = list.pairs();
+    }
+    omp_set_max_active_levels(levels);
+    EXPECT_EQ(innerPairs, expected.size());
   }
 }
 

@@ -137,8 +137,9 @@ void VolumeMapping::contributionsOf(const std::vector<KernelWeights>& w, CellCon
   out.start.resize(cells + 1);
 #pragma omp parallel num_threads(chunks) if (chunks > 1)
   {
-    const int k = omp_get_thread_num();
-    const long i0 = n * k / chunks, i1 = n * (k + 1) / chunks;
+    // The team may be smaller than asked (inside another parallel region): its own size splits the work.
+    const int team = omp_get_num_threads(), k = omp_get_thread_num();
+    const long i0 = n * k / team, i1 = n * (k + 1) / team;
     std::int32_t* mine = counts.data() + std::size_t(k) * cells;
     for (long i = i0; i < i1; ++i)
       for (int q = 0; q < w[std::size_t(i)].count; ++q) ++mine[w[std::size_t(i)].cell[std::size_t(q)]];
@@ -148,7 +149,7 @@ void VolumeMapping::contributionsOf(const std::vector<KernelWeights>& w, CellCon
       std::int32_t running = 0;
       for (std::size_t c = 0; c < cells; ++c) {
         out.start[c] = running;
-        for (int j = 0; j < chunks; ++j) {
+        for (int j = 0; j < team; ++j) {
           const std::int32_t here = counts[std::size_t(j) * cells + c];
           counts[std::size_t(j) * cells + c] = running;
           running += here;
