@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # The paper's lab bed end to end (docs/paper-reproduction.md): for ProCell without and with draft
 # plates, the coarse-grained CFD-DEM database job (examples/jobs/VARIANT-database.json), the D0
-# calibration against its reference period (the paper's 35 s per D0, 5 s discarded), and one hour of
-# spray at the selected D0 with the scene's 472,850 tracers; then a table of what each gives and the
+# calibration against its reference period (the paper's 35 s per D0, 5 s discarded), a spray over the
+# reference period with one tracer per parcel (against the coverage the full simulation recorded), and
+# one hour of spray at the selected D0 with the scene's 472,850 tracers; then a table of what each gives and the
 # beds' coverage distributions in one figure (OUT_DIR/coverage.svg, the paper's Fig. 12).
 #   bash scripts/paper.sh OUT_DIR [VARIANT ...]
 # VARIANT: procell-coarse-grained (no plates) and procell-coarse-grained-draft-plates (default: both).
 # Resumable: run it again with the same OUT_DIR; finished jobs are kept, interrupted ones resume from
 # their checkpoints. A database job takes hours on 2 cores (docs/performance.md), so put OUT_DIR outside
 # the repository. RCFD_PAPER_SPRAY_S sets the spray duration (default 3600 s), RCFD_PAPER_STAGES the
-# stages to run (default "database calibration spray"), RCFD_SOLVE the rcfd-solve to run (default
+# stages to run (default "database calibration comparison spray"), RCFD_SOLVE the rcfd-solve to run (default
 # build/rcfd-solve; a copy lets a rebuild go on beside a long job). Progress goes to the terminal and to
 # each job's log in OUT_DIR. Needs a build and jq.
 set -euo pipefail
@@ -23,7 +24,7 @@ shift
 variants=("$@")
 [ ${#variants[@]} -gt 0 ] || variants=(procell-coarse-grained procell-coarse-grained-draft-plates)
 spray_s=${RCFD_PAPER_SPRAY_S:-3600}
-stages=${RCFD_PAPER_STAGES:-database calibration spray}
+stages=${RCFD_PAPER_STAGES:-database calibration comparison spray}
 solve=${RCFD_SOLVE:-$(pwd)/build/rcfd-solve}
 command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq)" >&2; exit 2; }
 [ -x "$solve" ] || { echo "$0: no build; run scripts/build.sh" >&2; exit 2; }
@@ -50,6 +51,18 @@ for v in "${variants[@]}"; do
   [ -f "$out/cal-$v/summary.json" ] || continue
 
   d0=$(jq '.selected_d0' "$out/cal-$v/summary.json")
+  # The spray over the full simulation's reference period with one tracer per parcel: its coverage,
+  # overspray and stays against those the database job recorded on the parcels (the summary's
+  # coverage_comparison and stay_comparison), the check the hour's figures rest on.
+  duration=$(jq '.reference_coverage.duration_s // empty' "$out/db-$v/summary.json")
+  if [ -n "$duration" ]; then
+    jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" --argjson d0 "$d0" \
+      --argjson tracers "$(jq '.reference_coverage.parcels' "$out/db-$v/summary.json")" --argjson t "$duration" \
+      '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: {d0: $d0, tracers: $tracers}}),
+        database: $db, duration: $t, seed: 1, checkpoint_interval: 60.0}' > "$out/cmp-$v.json"
+    wants comparison && run_job "$v comparison" "$out/cmp-$v.json" "$out/cmp-$v"
+  fi
+
   jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" --argjson d0 "$d0" \
     --argjson t "$spray_s" \
     '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: {d0: $d0}}), database: $db,
@@ -95,6 +108,24 @@ for v in "${variants[@]}"; do
      (.coverage.p90 | r(1000)) + " (" + (.coverage.p90 - .coverage.p10 | r(1000)) + ")"] | @tsv' "$spray" |
     awk -F'\t' '{printf "%-38s %-17s %-15s %-17s %-8s %-8s %s\n", $1, $2, $3, $4, $5, $6, $7}'
 done
+
+# rCFD against the full simulation over the same reference period, one tracer per parcel.
+echo
+printf '%-38s %-9s %-10s %-10s %-10s %-8s %-10s %s\n' bed 'stay KS' 'mean stay' crossings 'coverage KS' \
+  'mean' 'p90' 'overspray rCFD/ref'
+for v in "${variants[@]}"; do
+  cmp=$out/cmp-$v/summary.json db=$out/db-$v/summary.json
+  [ -f "$cmp" ] || continue
+  jq -r --slurpfile ref "$db" --arg v "$v" 'def r(k): . * k | round / k | tostring;
+    def pct: if . == null then "n/a" else (. * 1000 | round / 10 | tostring) + "%" end;
+    [$v, (.stay_comparison.ks_distance // null | if . == null then "n/a" else r(1000) end),
+     (.stay_comparison.mean_relative_error | pct), (.stay_comparison.crossing_rate_relative_error | pct),
+     (.coverage_comparison.ks_distance // null | if . == null then "n/a" else r(1000) end),
+     (.coverage_comparison.mean_relative_error | pct), (.coverage_comparison.p90_relative_error | pct),
+     (.overspray_fraction | r(10000)) + "/" + ($ref[0].reference_coverage.overspray_fraction | r(10000))] | @tsv' "$cmp" |
+    awk -F'\t' '{printf "%-38s %-9s %-10s %-10s %-10s %-8s %-10s %s\n", $1, $2, $3, $4, $5, $6, $7, $8}'
+done
+echo "(the spray over the reference period with one tracer per parcel against the parcels' recorded spray)"
 
 # The paper's Fig. 12: the beds' coverage distributions in one figure, once their sprays are done.
 results=() labels=()
