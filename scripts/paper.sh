@@ -32,6 +32,15 @@ command -v jq > /dev/null || { echo "$0: jq is not installed (apt-get install jq
 source scripts/job-lib.sh
 wants() { [[ " $stages " == *" $1 "* ]]; }
 
+# A spray job on the database of variant $v: FILE, the scene's rcfd settings to change, duration, checkpoint
+# interval [s].
+write_spray_job() {
+  jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" --argjson rcfd "$2" \
+    --argjson t "$3" --argjson every "$4" \
+    '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: $rcfd}), database: $db,
+      duration: $t, seed: 1, checkpoint_interval: $every}' > "$1"
+}
+
 for v in "${variants[@]}"; do
   example=$(pwd)/examples/jobs/$v-database.json
   # The example's scene file resolved against examples/jobs/, so the jobs run from OUT_DIR.
@@ -56,17 +65,12 @@ for v in "${variants[@]}"; do
   # coverage_comparison and stay_comparison), the check the hour's figures rest on.
   duration=$(jq '.reference_coverage.duration_s // empty' "$out/db-$v/summary.json")
   if [ -n "$duration" ]; then
-    jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" --argjson d0 "$d0" \
-      --argjson tracers "$(jq '.reference_coverage.parcels' "$out/db-$v/summary.json")" --argjson t "$duration" \
-      '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: {d0: $d0, tracers: $tracers}}),
-        database: $db, duration: $t, seed: 1, checkpoint_interval: 60.0}' > "$out/cmp-$v.json"
+    tracers=$(jq '.reference_coverage.parcels' "$out/db-$v/summary.json")
+    write_spray_job "$out/cmp-$v.json" "{\"d0\": $d0, \"tracers\": $tracers}" "$duration" 60.0
     wants comparison && run_job "$v comparison" "$out/cmp-$v.json" "$out/cmp-$v"
   fi
 
-  jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" --argjson d0 "$d0" \
-    --argjson t "$spray_s" \
-    '{kind: "spray", scene_file: $scene, scene_patch: ($patch * {rcfd: {d0: $d0}}), database: $db,
-      duration: $t, seed: 1, checkpoint_interval: 300.0}' > "$out/spray-$v.json"
+  write_spray_job "$out/spray-$v.json" "{\"d0\": $d0}" "$spray_s" 300.0
   wants spray && run_job "$v spray" "$out/spray-$v.json" "$out/spray-$v"
 done
 
