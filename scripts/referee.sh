@@ -4,14 +4,16 @@
 # overspray and coverage of the recorded spray, pressure drop) move with the choices rcfd makes where
 # the paper is silent or differs. Each case is a database job: an example job with a patch.
 #   bash scripts/referee.sh OUT_DIR [CASE ...]
-# CASE (default: all but procell-cg3, which takes hours):
+# CASE (default: all but the procell ones, which take hours):
 #   quick, quick-seed2        the quick spout (2 s + 2 s) and another realisation: the scatter
 #   quick-cg1, quick-cg3      coarse graining 1 and 3 (dt_DEM at the same fraction of the Rayleigh time)
 #   quick-stiff               Young's modulus 50 MPa instead of 5 MPa (dt_DEM 8e-6 s, the same fraction of the Rayleigh time)
 #   quick-wen-yu              Wen & Yu drag instead of Beetstra's (minimum fluidisation at Wen-Yu's)
 #   quick-draft-plates-e030, -e035, -e045
 #                             the draft plates' lower edge at 30, 35 (the scene's) and 45 mm (10 s + 10 s)
-#   procell-cg3               the 3D ProCell at coarse graining 3
+#   procell-cg3               the 3D ProCell at coarse graining 3, 2 s + 4 s after the 3 s warm-up (about 2 h
+#                             on one thread): set beside the cg 2 database's two 10 s periods
+#   procell-cg3-cells10       the same on cells of 10 mm (1.85 parcel diameters, as cg 2's 7.4 mm are 2.06)
 # Resumable like scripts/paper.sh: finished jobs are kept, interrupted ones resume from their
 # checkpoints. RCFD_SOLVE sets the rcfd-solve to run (default build/rcfd-solve). Needs a build and jq.
 set -euo pipefail
@@ -38,7 +40,8 @@ declare -A cases=(
   [quick-draft-plates-e030]='quick-draft-plates-database-10s.json|{"scene_patch": {"apparatus": {"draft_plates": {"elevation": 0.030}}}}'
   [quick-draft-plates-e035]='quick-draft-plates-database-10s.json|{}'
   [quick-draft-plates-e045]='quick-draft-plates-database-10s.json|{"scene_patch": {"apparatus": {"draft_plates": {"elevation": 0.045}}}}'
-  [procell-cg3]='procell-coarse-grained-database.json|{"scene_patch": {"dem": {"coarse_graining": 3, "time_step": 4e-5}}}'
+  [procell-cg3-cells10]='procell-coarse-grained-database.json|{"scene_patch": {"grid": {"cell_size": 0.01}, "dem": {"coarse_graining": 3, "time_step": 4e-5, "sample_duration": 2.0, "reference_duration": 4.0}}}'
+  [procell-cg3]='procell-coarse-grained-database.json|{"scene_patch": {"dem": {"coarse_graining": 3, "time_step": 4e-5, "sample_duration": 2.0, "reference_duration": 4.0}}}'
 )
 order=(quick quick-seed2 quick-cg3 quick-wen-yu quick-stiff quick-cg1 quick-draft-plates-e035
        quick-draft-plates-e030 quick-draft-plates-e045)
