@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 
 #include "core/Errors.hpp"
@@ -107,13 +108,28 @@ Selection selectD0(const std::vector<D0Scores>& s, const SelectionOptions& o, bo
     }
   }
   if (!found) {
-    // No D0 met both: the lowest whose bed shape agrees, else the best-shaped one.
-    sel.selected = bestShape;
+    // No D0 met both. Where some bed shape agrees, the paper's order holds: the lowest such D0. Where
+    // none does, the bed shape cannot tell a viable D0 from another, and the residence times, on which
+    // the coverage rests, decide: the best-shaped D0 among those whose residence times agree, else the
+    // best-shaped of all.
+    std::optional<std::size_t> lowestShaped, bestShapedAgreeing;
     for (const std::size_t i : order) {
-      if (sel.bedShapeAgrees[i]) {
-        sel.selected = i;
-        break;
+      if (sel.bedShapeAgrees[i] && !lowestShaped) lowestShaped = i;
+      if (sel.residenceTimesAgree[i] &&
+          (!bestShapedAgreeing || s[i].rmsOverFloor() < s[*bestShapedAgreeing].rmsOverFloor())) {
+        bestShapedAgreeing = i;
       }
+    }
+    std::string why;
+    if (lowestShaped) {
+      sel.selected = *lowestShaped;
+      why = "lowest whose " + bed + " agrees";
+    } else if (bestShapedAgreeing) {
+      sel.selected = *bestShapedAgreeing;
+      why = "one with the best bed shape among those whose residence times agree (no bed shape does)";
+    } else {
+      sel.selected = bestShape;
+      why = "one with the best bed shape";
     }
     // Name the values that met the residence-time criterion alone, if any: they are what a wider
     // tolerance or more tracers (a lower counting floor) would select.
@@ -124,9 +140,8 @@ Selection selectD0(const std::vector<D0Scores>& s, const SelectionOptions& o, bo
     const std::string rtdClause = rtdOnly.empty()
         ? ", and no value met the " + rtd + " criterion"
         : "; the " + rtd + " agree at D0 = " + rtdOnly + " m2/s, whose bed shape does not";
-    sel.reason = "no D0 met both criteria; D0 = " + g3(s[sel.selected].d0) + " m2/s is the " +
-                 (sel.bedShapeAgrees[sel.selected] ? "lowest whose " + bed + " agrees" : "one with the best bed shape") +
-                 " (" + scores(sel.selected) + ")" + rtdClause + penalty;
+    sel.reason = "no D0 met both criteria; D0 = " + g3(s[sel.selected].d0) + " m2/s is the " + why + " (" +
+                 scores(sel.selected) + ")" + rtdClause + penalty;
   }
   sel.atUpperEnd = n > 1 && (sel.selected == top || sel.penaltyMinimum == top);
   return sel;

@@ -57,7 +57,7 @@ SelectionOptions selectionOptionsFrom(const nlohmann::json& jobDocument);
 struct Selection {
   std::size_t penaltyMinimum = 0;  ///< index into the scores
   std::size_t selected = 0;        ///< index into the scores
-  bool ruleSatisfied = false;      ///< false: no D0 met both criteria, fell back to bed shape only
+  bool ruleSatisfied = false;      ///< false: no D0 met both criteria (docs/calibration.md, "Selection")
   std::vector<bool> bedShapeAgrees, residenceTimesAgree;
   std::string reason;              ///< one line: why `selected`
   /// The selection or the penalty minimum is the largest D0 of the list: the optimum may lie beyond.

@@ -115,6 +115,49 @@ TEST(Selection, NamesTheValuesWhoseResidenceTimesAloneAgree) {
   EXPECT_NE(sel.reason.find("agree at D0 = 1e-05 m2/s, whose bed shape does not"), std::string::npos) << sel.reason;
 }
 
+// Where no D0 reaches the bed shape, the residence times decide: the best-shaped D0 among those whose
+// residence times agree, not the best-shaped of all, whose stays may have drifted away.
+TEST(Selection, WithoutAnAgreeingBedShapeTheResidenceTimesDecide) {
+  auto s = paperLike();
+  for (auto& x : s) x.instantaneousRms = 2.0 * x.instantaneousRms;  // every run 2.2-6 x its floor...
+  s[5].instantaneousRms = 1.9 * s[5].countingFloorRms;  // ...1e-2 the best shape, 1.9 x...
+  s[5].ksDistance = 0.15;                                // ...but its stays are off
+  Selection sel = selectD0(s, SelectionOptions{}, true);
+  EXPECT_FALSE(sel.ruleSatisfied);
+  EXPECT_EQ(s[sel.selected].d0, 1e-3) << sel.reason;  // 2.2 x the floor against 5e-4's 2.4 x
+  EXPECT_NE(sel.reason.find("best bed shape among those whose residence times agree"), std::string::npos)
+      << sel.reason;
+  for (auto& x : s) x.ksDistance = 0.9;  // none agrees: the best shape of all
+  sel = selectD0(s, SelectionOptions{}, true);
+  EXPECT_EQ(s[sel.selected].d0, 1e-2) << sel.reason;
+  s[4].instantaneousRms = 1.2 * s[4].countingFloorRms;  // 1e-3's shape agrees: the lowest that does
+  EXPECT_EQ(s[selectD0(s, SelectionOptions{}, true).selected].d0, 1e-3);
+}
+
+// The scores of the 3D ProCell bed without plates (docs/paper/no-plates-cal-summary.json, 472,850
+// tracers): no bed shape within 1.25 x its floor, the residence times agreeing from 1e-4 to 3e-2 and the
+// stays 12 % short at the top of the sweep, where the bed shape is best. The selection stays inside.
+TEST(Selection, TheProCellSweepSelectsInsideIt) {
+  struct Row { double d0, penalty, rmsOverFloor, mean, ks, meanError, rateError; };
+  const Row rows[] = {{0, 0.00230277, 5.17, 0.066214, 0.02982, -0.02664, -0.101},
+                      {1e-05, 0.00229591, 5.129, 0.066263, 0.02931, -0.02591, -0.1008},
+                      {1e-4, 0.00223141, 4.952, 0.066202, 0.0302, -0.02682, -0.09993},
+                      {5e-4, 0.0020953, 4.59, 0.066162, 0.03026, -0.0274, -0.09819},
+                      {1e-3, 0.00197659, 4.319, 0.066118, 0.03044, -0.02804, -0.09585},
+                      {1e-2, 0.0014123, 3.15, 0.065237, 0.03507, -0.04097, -0.0739},
+                      {3e-2, 0.00116727, 2.566, 0.063552, 0.04505, -0.06572, -0.0409},
+                      {0.09, 0.000969165, 2.048, 0.059941, 0.06906, -0.1187, 0.01805},
+                      {0.09425, 0.000962832, 2.028, 0.05971, 0.07086, -0.1222, 0.02192}};
+  std::vector<D0Scores> s;
+  for (const Row& r : rows) s.push_back(score(r.d0, r.penalty, r.rmsOverFloor, r.mean, r.ks, r.meanError, r.rateError));
+  const Selection sel = selectD0(s, SelectionOptions{}, true);
+  EXPECT_EQ(s[sel.selected].d0, 3e-2) << sel.reason;
+  EXPECT_EQ(s[sel.penaltyMinimum].d0, 0.09425);
+  EXPECT_TRUE(sel.atUpperEnd);  // the penalty minimum is still the top
+  EXPECT_FALSE(sel.residenceTimesAgree[1]);  // 1e-5 crosses 10.08 % too rarely
+  EXPECT_TRUE(sel.residenceTimesAgree[2]);
+}
+
 TEST(Selection, RunWithoutStaysHasNoAgreeingResidenceTimes) {
   auto s = paperLike();
   s[3].stays = 0;
