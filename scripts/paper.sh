@@ -4,7 +4,8 @@
 # calibration against its reference period (the paper's 35 s per D0, 5 s discarded), a spray over the
 # reference period with one tracer per parcel (against the coverage the full simulation recorded), and
 # one hour of spray at the selected D0 with the scene's 472,850 tracers; then a table of what each gives and the
-# beds' coverage distributions in one figure (OUT_DIR/coverage.svg, the paper's Fig. 12).
+# beds' coverage distributions in one figure (OUT_DIR/coverage.svg, the paper's Fig. 12). Each database also
+# gets its droplet paths (OUT_DIR/db-VARIANT/droplet-paths.json: where the bed catches the spray).
 #   bash scripts/paper.sh OUT_DIR [VARIANT ...]
 # VARIANT: procell-coarse-grained (no plates) and procell-coarse-grained-draft-plates (default: both).
 # Resumable: run it again with the same OUT_DIR; finished jobs are kept, interrupted ones resume from
@@ -52,6 +53,13 @@ for v in "${variants[@]}"; do
   patch=$(jq -n --argjson p "$patch" '$p * {rcfd: {velocity_interpolation: "mass_weighted"}}')
   wants database && run_job "$v database" "$out/db-$v.json" "$out/db-$v"
   [ -f "$out/db-$v/summary.json" ] || continue
+  # Where the full simulation's bed catches the spray (docs/paper-reproduction.md, "Where the bed
+  # catches the spray"): seconds, so run whenever it is missing.
+  paths=$out/db-$v/droplet-paths.json
+  if [ ! -f "$paths" ]; then
+    "$solve" droplet-paths "$out/db-$v/database.h5" --launches 128 --paths 64 \
+      --heights 0.05,0.1,0.15,0.2,0.3,0.4 > "$paths.part" && mv "$paths.part" "$paths"
+  fi
 
   jq -n --arg scene "$scene" --argjson patch "$patch" --arg db "$out/db-$v/database.h5" \
     '{kind: "calibration", scene_file: $scene, scene_patch: $patch, database: $db, duration: 35.0,

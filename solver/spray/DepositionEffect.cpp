@@ -53,12 +53,7 @@ class DepositionEffect final : public TracerEffect, public ParcelDeposition {
  public:
   explicit DepositionEffect(TracerContext& ctx)
       : model_(DepositionModelRegistry::create(ctx.scene.spray.deposition_model)), state_(ctx.spray),
-        scanDueCells_(spray::dueCellScanFor(kernelIsa())) {
-    constants_.particleDiameter = ctx.scene.particles.diameter;
-    constants_.dropletDiameter = ctx.scene.spray.droplet_diameter;
-    constants_.dropletDensity = ctx.scene.spray.droplet_density;
-    constants_.gasDensity = ctx.scene.gas.density;
-    constants_.gasViscosity = ctx.scene.gas.kinematic_viscosity;
+        scanDueCells_(spray::dueCellScanFor(kernelIsa())), constants_(depositionConstants(ctx.scene)) {
     state_->cellDeposit.assign(std::size_t(ctx.grid.cellCount()), 0.0);
     state_->cellPending.assign(std::size_t(ctx.grid.cellCount()), 0.0);
     state_->tracerDroplets.assign(ctx.cloud.size(), 0.0);

@@ -4,7 +4,19 @@
 #include <cmath>
 #include <memory>
 
+#include "scene/Scene.hpp"
+
 namespace rcfd {
+
+DepositionConstants depositionConstants(const Scene& scene) {
+  DepositionConstants c;
+  c.particleDiameter = scene.particles.diameter;
+  c.dropletDiameter = scene.spray.droplet_diameter;
+  c.dropletDensity = scene.spray.droplet_density;
+  c.gasDensity = scene.gas.density;
+  c.gasViscosity = scene.gas.kinematic_viscosity;
+  return c;
+}
 
 double happelParameter(double alphaP) {
   const double a = std::clamp(alphaP, 0.0, kMaxPackingForDeposition);

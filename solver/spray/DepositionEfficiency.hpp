@@ -21,6 +21,8 @@ struct DepositionInput {
   double dt = 0.0;           ///< time over which the parcel is exposed [s]
 };
 
+struct Scene;
+
 /// Material constants of Eq. (11)-(14).
 struct DepositionConstants {
   double particleDiameter = 1.8e-3;  ///< d_P [m]
@@ -29,6 +31,9 @@ struct DepositionConstants {
   double gasDensity = 1.225;         ///< rho_G [kg/m3]
   double gasViscosity = 1.5e-5;      ///< nu_G [m2/s]
 };
+
+/// The constants of a scene: its particles', droplets' and gas's.
+DepositionConstants depositionConstants(const Scene& scene);
 
 /// Largest alpha_P the correlation is evaluated at: the densest packing of equal spheres (FCC/HCP,
 /// pi / (3 sqrt 2) = 0.7405; random close packing is about 0.64); denser cells (tracer over-packing)

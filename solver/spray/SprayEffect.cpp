@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "geometry/WallClearance.hpp"
+#include "spray/SprayLaunch.hpp"
 #include "spray/SprayState.hpp"
 #include "tracers/BlockSampling.hpp"
 #include "tracers/CellIndex.hpp"
@@ -118,13 +119,8 @@ class SprayEffect final : public TracerEffect {
     for (std::int64_t j = 0; j < n; ++j) {
       const std::int64_t index = s.injectedParcels + j;
       CounterRng rng(ctx.seed, RngPurpose::SprayInjection, std::uint64_t(index), 0);
-      // Direction uniform in solid angle within the cone around +y.
-      const double cosTheta = 1.0 - rng.uniform() * (1.0 - cosHalfAngle_);
-      const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
-      const double phi = 2.0 * std::numbers::pi * rng.uniform();
-      const Eigen::Vector3d dir(sinTheta * std::cos(phi), cosTheta, sinTheta * std::sin(phi));
-      const double r = 0.5 * spec_.nozzle_diameter + launchSpread_ * rng.uniform();
-      const Eigen::Vector3d p = spec_.nozzle_position + r * dir;
+      const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+      const Eigen::Vector3d p = sprayLaunchPoint(spec_, cosHalfAngle_, launchSpread_, u1, u2, u3);
       if (ctx.apparatus.signedDistance(p) > 0.0) {
         s.parcels.push(p, s.dropletsPerParcel, index);
       } else {

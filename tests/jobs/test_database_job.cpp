@@ -265,6 +265,18 @@ TEST_F(DatabaseJob, DemOnlyJobWritesALoadableDatabaseAndTheContractKeys) {
   EXPECT_EQ(fj["probes"], s["probes"]);
   EXPECT_EQ(fj["pressure_drop"]["samples"].get<int>(), 80);
   EXPECT_TRUE(fs::exists(dir_ / "figs" / "database_alpha_p.svg"));
+
+  // rcfd-solve droplet-paths follows the spray through the same file's 10 frames of 5 ms.
+  const std::string file = (dir_ / "a" / "database.h5").string();
+  const SolveResult paths = solve("droplet-paths " + file + " --launches 3 --paths 8 --max-seconds 0.02 --heights 0.01,0.05");
+  ASSERT_EQ(paths.exitCode, 0) << paths.out;
+  const json pj = json::parse(paths.out);
+  EXPECT_NEAR(pj["outlet"].get<double>() + pj["wall"].get<double>() + pj["airborne"].get<double>() +
+                  pj["deposited"].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(pj["heights"].size(), 2u);
+  const SolveResult tooLong = solve("droplet-paths " + file + " --max-seconds 1", true);
+  EXPECT_EQ(tooLong.exitCode, 2);
+  EXPECT_NE(tooLong.out.find("/max_seconds"), std::string::npos) << tooLong.out;
 }
 
 TEST_F(DatabaseJob, TheVelocitySpreadIsWrittenWhenATracerEffectReadsItAndAddsUpToTheMean) {

@@ -346,12 +346,7 @@ TEST(Spray, AParcelDepositsAlongItsWholeFlightWhateverTheRcfdStep) {
     ASSERT_GT(alpha, 0.0f);
     for (const float a : ctx.tracerAlpha) ASSERT_EQ(a, alpha);
     const auto model = DepositionModelRegistry::create(s.spray.deposition_model);
-    DepositionConstants constants;
-    constants.particleDiameter = s.particles.diameter;
-    constants.dropletDiameter = s.spray.droplet_diameter;
-    constants.dropletDensity = s.spray.droplet_density;
-    constants.gasDensity = s.gas.density;
-    constants.gasViscosity = s.gas.kinematic_viscosity;
+    const DepositionConstants constants = depositionConstants(s);
     const double k = -std::log1p(-model->efficiency({double(alpha), U, 1e-3}, constants)) / 1e-3;
     const double n0 = spray.dropletsPerParcel;
     const double tMin = (kHeight - 0.005 - 0.5 * s.spray.nozzle_diameter - 0.01) / U;
