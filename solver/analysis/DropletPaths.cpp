@@ -107,6 +107,10 @@ class PathTracer {
   double minSpacing_;
 };
 
+/// Paths and heights of one call: every path's survival at every height is kept for the quantiles.
+constexpr std::int64_t kMaxPaths = 1000000;
+constexpr std::size_t kMaxHeights = 100;
+
 /// Survival below this reads as this (an optical depth of 708): every droplet caught.
 constexpr double kLeastSurvival = std::numeric_limits<double>::min();
 
@@ -119,6 +123,9 @@ void check(bool ok, const std::string& pointer, const std::string& message) {
 DropletPathReport dropletPaths(const Scene& scene, const FieldDatabase& db, const DropletPathOptions& o) {
   check(o.launches >= 1 && o.launches <= 100000, "/launches", "must be in [1, 100000]");
   check(o.pathsPerLaunch >= 1 && o.pathsPerLaunch <= 100000, "/paths_per_launch", "must be in [1, 100000]");
+  check(std::int64_t(o.launches) * o.pathsPerLaunch <= kMaxPaths, "/paths_per_launch",
+        "launches x paths per launch must not exceed " + std::to_string(kMaxPaths) + " (every path's ends are kept)");
+  check(o.heights.size() <= kMaxHeights, "/heights", "at most " + std::to_string(kMaxHeights) + " heights");
   check(std::isfinite(o.maxSeconds) && o.maxSeconds > 0.0, "/max_seconds", "must be a positive number of seconds");
   // A path reads the frame after the one it is in: maxSeconds spans this many frame intervals.
   const int span = int(std::ceil(o.maxSeconds / db.dtRec())) + 1;

@@ -56,7 +56,7 @@ struct DropletPathReport {
 };
 
 /// rcfd::InputError naming the option when the database is too short for maxSeconds or an option is
-/// out of range.
+/// out of range (at most 1,000,000 paths in all and 100 heights).
 DropletPathReport dropletPaths(const Scene& scene, const FieldDatabase& db, const DropletPathOptions& options);
 
 }  // namespace rcfd::analysis

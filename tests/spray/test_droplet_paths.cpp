@@ -109,4 +109,12 @@ TEST(DropletPaths, RefusesAFlightLongerThanTheFrames) {
   o.maxSeconds = 0.05;
   o.launches = 0;
   EXPECT_THROW(analysis::dropletPaths(s, *db, o), InputError);
+  o.launches = 100000;  // 1e9 paths: refused before anything is allocated
+  o.pathsPerLaunch = 10000;
+  try {
+    analysis::dropletPaths(s, *db, o);
+    FAIL() << "1e9 paths were accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.violations().at(0).pointer, "/paths_per_launch");
+  }
 }
