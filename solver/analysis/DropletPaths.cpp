@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -139,13 +140,22 @@ DropletPathReport dropletPaths(const Scene& scene, const FieldDatabase& db, cons
   const int lastFirst = db.frameCount() - 1 - span;
   const std::int64_t paths = std::int64_t(o.launches) * o.pathsPerLaunch;
   std::vector<PathEnd> ends(static_cast<std::size_t>(paths));
+  // A frame that fails to load (NaN found by a cached database) throws after the loop: exceptions must
+  // not leave an OpenMP region.
+  std::exception_ptr failure;
   // Paths are independent and each draws from its own counter stream: any thread count, same result.
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t i = 0; i < paths; ++i) {
     const int launch = int(i / o.pathsPerLaunch);
     const int first = o.launches == 1 ? 0 : int(std::llround(double(launch) * lastFirst / (o.launches - 1)));
-    ends[std::size_t(i)] = tracer.trace(first, std::uint64_t(i));
+    try {
+      ends[std::size_t(i)] = tracer.trace(first, std::uint64_t(i));
+    } catch (...) {
+#pragma omp critical(rcfd_droplet_paths_failure)
+      if (!failure) failure = std::current_exception();
+    }
   }
+  if (failure) std::rethrow_exception(failure);
 
   DropletPathReport r;
   r.launches = o.launches;

@@ -118,3 +118,21 @@ TEST(DropletPaths, RefusesAFlightLongerThanTheFrames) {
     EXPECT_EQ(e.violations().at(0).pointer, "/paths_per_launch");
   }
 }
+
+TEST(DropletPaths, AFrameWithNaNIsAnInputErrorNotACrash) {
+  // A cached database validates a frame when a path first reads it, inside the parallel loop.
+  RawSpec spec;
+  spec.nx = 10, spec.ny = 20, spec.nz = 4;
+  spec.frames = 40;
+  spec.dtRec = 0.005;
+  spec.nanFrame = 2;
+  const std::string path = tempPath("droplet-paths-nan.h5");
+  writeRawDatabase(path, spec);
+  const auto db = FieldDatabase::open(path, FrameStorage{std::int64_t(1) << 24});
+  const Scene s = sprayBoxScene(100, kLayerAlpha, 0.2);
+  analysis::DropletPathOptions o;
+  o.launches = 2;
+  o.pathsPerLaunch = 4;
+  o.maxSeconds = 0.05;
+  EXPECT_THROW(analysis::dropletPaths(s, *db, o), InputError);
+}
