@@ -1,5 +1,5 @@
 // rcfd-solve droplet-paths DB.h5 [--launches N] [--paths N] [--max-seconds S] [--heights Y1,Y2,..]
-// [--seed N]: where the bed of a field database catches the spray (analysis/DropletPaths.hpp): droplet
+// [--seed N]: where the bed of a field database catches the spray (spray/DropletPaths.hpp): droplet
 // paths from the nozzle through the frames in their own order, with the scene's deposition model on the
 // frames' alpha_P. Prints JSON: the shares that leave through the outlet, reach a wall, stay airborne
 // and deposit; the overspray's spread over the launch instants; per height, the share deposited below
@@ -9,7 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "analysis/DropletPaths.hpp"
+#include "spray/DropletPaths.hpp"
 #include "cli/Command.hpp"
 #include "core/Errors.hpp"
 #include "fields/FieldDatabase.hpp"
@@ -23,13 +23,13 @@ constexpr std::int64_t kCacheBytes = 1LL << 30;
 
 struct Options {
   std::string database;
-  analysis::DropletPathOptions paths;
+  DropletPathOptions paths;
 };
 
 int run(const Options& o) {
   auto db = FieldDatabase::open(o.database, FrameStorage{kCacheBytes});
   const Scene scene = loadSceneText(db->sceneJson(), o.database + ":/scene");
-  const auto r = analysis::dropletPaths(scene, *db, o.paths);
+  const auto r = dropletPaths(scene, *db, o.paths);
   nlohmann::json heights = nlohmann::json::array();
   for (const auto& h : r.heights) {
     heights.push_back({{"y_m", h.y},

@@ -1,11 +1,11 @@
-// Droplet paths through a database's frames (analysis/DropletPaths.hpp): Eq. (11)-(14) across a layer of
+// Droplet paths through a database's frames (spray/DropletPaths.hpp): Eq. (11)-(14) across a layer of
 // known thickness, where the droplets end, thread independence, and the option checks.
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <cmath>
 
-#include "analysis/DropletPaths.hpp"
+#include "spray/DropletPaths.hpp"
 #include "core/Errors.hpp"
 #include "spray/DepositionEfficiency.hpp"
 #include "SprayTestSupport.hpp"
@@ -32,8 +32,8 @@ std::shared_ptr<FieldDatabase> layerDatabase(const Scene& s, int frames) {
   });
 }
 
-analysis::DropletPathOptions layerOptions() {
-  analysis::DropletPathOptions o;
+DropletPathOptions layerOptions() {
+  DropletPathOptions o;
   o.launches = 4;
   o.pathsPerLaunch = 16;
   o.maxSeconds = 0.5;
@@ -46,7 +46,7 @@ analysis::DropletPathOptions layerOptions() {
 TEST(DropletPaths, ALayerPassesExpOfMinusItsOpticalDepth) {
   const Scene s = sprayBoxScene(100, kLayerAlpha, 0.2);
   const auto db = layerDatabase(s, 120);
-  const auto r = analysis::dropletPaths(s, *db, layerOptions());
+  const auto r = dropletPaths(s, *db, layerOptions());
   // Eq. (11) with the exponential model over the layer's 3 cm at the rise speed: tau = 1.5 lambda a L / d_P.
   const double lambda = filterCoefficient({kLayerAlpha, kRise, 0.0}, depositionConstants(s));
   const double tau = 1.5 * lambda * kLayerAlpha * (kLayerTop - kLayerBottom) / s.particles.diameter;
@@ -72,15 +72,15 @@ TEST(DropletPaths, ALayerPassesExpOfMinusItsOpticalDepth) {
 TEST(DropletPaths, EveryDropletEndsSomewhereWhateverTheThreadCount) {
   const Scene s = sprayBoxScene(100, 0.05, 0.12);
   const auto db = sprayBoxDatabase(s, 0.05, 0.12, 1.5, 200);  // swaying gas: paths reach the side walls too
-  analysis::DropletPathOptions o;
+  DropletPathOptions o;
   o.launches = 8;
   o.pathsPerLaunch = 32;
   o.maxSeconds = 0.3;
   o.heights = {0.05, 0.1, 0.15};
   omp_set_num_threads(1);
-  const auto one = analysis::dropletPaths(s, *db, o);
+  const auto one = dropletPaths(s, *db, o);
   omp_set_num_threads(2);
-  const auto two = analysis::dropletPaths(s, *db, o);
+  const auto two = dropletPaths(s, *db, o);
   EXPECT_NEAR(one.outlet + one.wall + one.airborne + one.deposited, 1.0, 1e-12);
   EXPECT_GT(one.deposited, 0.0);
   EXPECT_GT(one.wall + one.outlet, 0.0);
@@ -100,7 +100,7 @@ TEST(DropletPaths, RefusesAFlightLongerThanTheFrames) {
   const auto db = layerDatabase(s, 20);  // 0.1 s of frames
   auto o = layerOptions();
   try {
-    analysis::dropletPaths(s, *db, o);
+    dropletPaths(s, *db, o);
     FAIL() << "a 0.5 s flight through 0.1 s of frames was accepted";
   } catch (const InputError& e) {
     ASSERT_EQ(e.violations().size(), 1u);
@@ -108,11 +108,11 @@ TEST(DropletPaths, RefusesAFlightLongerThanTheFrames) {
   }
   o.maxSeconds = 0.05;
   o.launches = 0;
-  EXPECT_THROW(analysis::dropletPaths(s, *db, o), InputError);
+  EXPECT_THROW(dropletPaths(s, *db, o), InputError);
   o.launches = 100000;  // 1e9 paths: refused before anything is allocated
   o.pathsPerLaunch = 10000;
   try {
-    analysis::dropletPaths(s, *db, o);
+    dropletPaths(s, *db, o);
     FAIL() << "1e9 paths were accepted";
   } catch (const InputError& e) {
     EXPECT_EQ(e.violations().at(0).pointer, "/paths_per_launch");
@@ -130,9 +130,9 @@ TEST(DropletPaths, AFrameWithNaNIsAnInputErrorNotACrash) {
   writeRawDatabase(path, spec);
   const auto db = FieldDatabase::open(path, FrameStorage{std::int64_t(1) << 24});
   const Scene s = sprayBoxScene(100, kLayerAlpha, 0.2);
-  analysis::DropletPathOptions o;
+  DropletPathOptions o;
   o.launches = 2;
   o.pathsPerLaunch = 4;
   o.maxSeconds = 0.05;
-  EXPECT_THROW(analysis::dropletPaths(s, *db, o), InputError);
+  EXPECT_THROW(dropletPaths(s, *db, o), InputError);
 }

@@ -19,7 +19,7 @@
 #include "fields/FieldDatabase.hpp"
 #include "scene/Scene.hpp"
 
-namespace rcfd::analysis {
+namespace rcfd {
 
 struct DropletPathOptions {
   int launches = 64;            ///< launch instants, evenly spread over the frames that leave maxSeconds after them
@@ -59,4 +59,4 @@ struct DropletPathReport {
 /// out of range (at most 1,000,000 paths in all and 100 heights).
 DropletPathReport dropletPaths(const Scene& scene, const FieldDatabase& db, const DropletPathOptions& options);
 
-}  // namespace rcfd::analysis
+}  // namespace rcfd

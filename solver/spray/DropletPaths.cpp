@@ -1,4 +1,4 @@
-#include "analysis/DropletPaths.hpp"
+#include "spray/DropletPaths.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@
 #include "tracers/CounterRng.hpp"
 #include "tracers/FrameSampler.hpp"
 
-namespace rcfd::analysis {
+namespace rcfd {
 namespace {
 
 /// What one path did: the share of its droplets that ended where, and its survival on first reaching
@@ -201,4 +201,4 @@ DropletPathReport dropletPaths(const Scene& scene, const FieldDatabase& db, cons
   return r;
 }
 
-}  // namespace rcfd::analysis
+}  // namespace rcfd
