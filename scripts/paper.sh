@@ -139,6 +139,21 @@ for v in "${variants[@]}"; do
 done
 echo "(the spray over the reference period with one tracer per parcel against the parcels' recorded spray)"
 
+# Where each bed catches the spray: the droplet paths through its frames (on smoothed frames the deposit
+# comes too low; docs/paper-reproduction.md, "Where the bed catches the spray").
+echo
+printf '%-38s %-12s %-12s %-12s %-12s %s\n' bed 'below 0.1 m' 'below 0.2 m' 'tau at 0.4 m' 'paths os' 'recorded os'
+for v in "${variants[@]}"; do
+  paths=$out/db-$v/droplet-paths.json db=$out/db-$v/summary.json
+  [ -f "$paths" ] || continue
+  jq -r --slurpfile ref "$db" --arg v "$v" 'def r(k): . * k | round / k | tostring;
+    def at(y): .heights[] | select((.y_m - y) | fabs < 1e-9);
+    [$v, (at(0.1).deposited_below | r(1000)), (at(0.2).deposited_below | r(1000)),
+     (at(0.4).optical_depth.median | r(10)), (.overspray | r(100000)),
+     ($ref[0].reference_coverage.overspray_fraction // null | if . == null then "n/a" else r(100000) end)] | @tsv' "$paths" |
+    awk -F'\t' '{printf "%-38s %-12s %-12s %-12s %-12s %s\n", $1, $2, $3, $4, $5, $6}'
+done
+
 # The paper's Fig. 12: the beds' coverage distributions in one figure, once their sprays are done.
 results=() labels=()
 for v in "${variants[@]}"; do
