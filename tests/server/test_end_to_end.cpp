@@ -109,11 +109,32 @@ std::vector<pid_t> childrenOf(pid_t parent) {
 }
 
 /// True while `pid` exists and is not a zombie (an orphan's zombie may wait for a non-reaping init).
-bool processRunning(pid_t pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+/// The state letter of /proc/<path>/stat (R, S, T, Z, ...); 0 when the file is gone.
+static char procState(const std::string& path) {
+  std::ifstream stat("/proc/" + path + "/stat");
   std::string text((std::istreambuf_iterator<char>(stat)), {});
   const auto close = text.rfind(')');
-  return close != std::string::npos && close + 2 < text.size() && text[close + 2] != 'Z';
+  return close != std::string::npos && close + 2 < text.size() ? text[close + 2] : 0;
+}
+
+bool processRunning(pid_t pid) {
+  const char state = procState(std::to_string(pid));
+  return state != 0 && state != 'Z';
+}
+
+/// Whether every thread of `pid` is stopped (group stop done): from then on a signal sent to it stays
+/// pending until SIGCONT. Right after kill(SIGSTOP) it need not be: a thread that has not yet taken the
+/// SIGSTOP takes a SIGTERM sent meanwhile first (the lower number), runs its handler, and only then stops.
+static bool allThreadsStopped(pid_t pid) {
+  const auto tasks = std::filesystem::path("/proc") / std::to_string(pid) / "task";
+  std::error_code ec;
+  bool any = false;
+  for (const auto& task : std::filesystem::directory_iterator(tasks, ec)) {
+    const char state = procState(std::to_string(pid) + "/task/" + task.path().filename().string());
+    if (state != 'T' && state != 't') return false;
+    any = true;
+  }
+  return any && !ec;
 }
 
 class EndToEnd : public ::testing::Test {
@@ -299,12 +320,16 @@ TEST_F(EndToEnd, AKilledSolverIsRetriedFromItsCheckpointAutomaticallyAndOnReques
   EXPECT_EQ(requested, 1) << events.dump(2);
 }
 
-/// The server's one solver, stopped (SIGSTOP) once `checkpoint` exists; -1 when none is seen within 30 s.
+/// The server's one solver, stopped (SIGSTOP) once `checkpoint` exists, returned when all its threads
+/// have stopped (or it has ended, which the callers check); -1 when none is seen within 30 s.
 pid_t freezeSolverAtItsCheckpoint(pid_t server, const std::filesystem::path& checkpoint) {
   for (int i = 0; i < 6000; ++i) {
     const auto solvers = childrenOf(server);
-    if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0)
+    if (solvers.size() == 1 && std::filesystem::exists(checkpoint) && ::kill(solvers[0], SIGSTOP) == 0) {
+      for (int j = 0; j < 2000 && processRunning(solvers[0]) && !allThreadsStopped(solvers[0]); ++j)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
       return solvers[0];
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   return -1;
