@@ -51,13 +51,12 @@ bool memberHistograms(const std::vector<json>& members, std::vector<double>& edg
   return !counts.empty();
 }
 
-std::string memberName(std::size_t k) {
-  char name[8];
-  std::snprintf(name, sizeof name, "%02zu", k);
-  return name;
-}
-
 }  // namespace
+
+std::string ensembleMemberName(std::size_t k) {
+  const std::string digits = std::to_string(k);
+  return digits.size() < 2 ? "0" + digits : digits;
+}
 
 std::vector<std::uint64_t> ensembleSeeds(std::uint64_t jobSeed, int members) {
   constexpr std::uint64_t kMask = (std::uint64_t(1) << 53) - 1;
@@ -176,7 +175,7 @@ void writeEnsembleResults(h5::File& out, const json& ensemble, const std::vector
   }
   // The members' own results: member 0's are the root's (linked, not copied).
   for (std::size_t m = 0; m < k; ++m) {
-    const std::string group = "/ensemble/members/" + memberName(m);
+    const std::string group = "/ensemble/members/" + ensembleMemberName(m);
     out.createGroup(group);
     out.setAttribute(group, "seed", std::int64_t(seeds.at(m)));
     out.writeString(group + "/summary", memberSummaries.at(m).dump(2));

@@ -25,6 +25,9 @@ inline constexpr int kMaxEnsembleMembers = 64;
 /// distinct from the members before it. The same (seed, k) always gives the same seed, whatever K.
 std::vector<std::uint64_t> ensembleSeeds(std::uint64_t jobSeed, int members);
 
+/// Member k's name in the result tree and its directory under DIR/members/: two digits or more ("07").
+std::string ensembleMemberName(std::size_t k);
+
 /// JSON pointers into a spray job's summary of the statistics the ensemble reports as mean and
 /// spread (those present as numbers in every member's summary).
 const std::vector<std::string>& ensembleStatisticPointers();

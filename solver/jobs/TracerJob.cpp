@@ -261,11 +261,7 @@ class TracerJob final : public JobRunner {
     const int members = job.ensemble_members;
     const std::vector<std::uint64_t> seeds = ensembleSeeds(job.seed, members);
     const std::string membersDir = options.outDir + "/members";
-    auto memberDir = [&](int k) {
-      char name[8];
-      std::snprintf(name, sizeof name, "%02d", k);
-      return membersDir + "/" + name;
-    };
+    auto memberDir = [&](int k) { return membersDir + "/" + ensembleMemberName(std::size_t(k)); };
     // A member is finished when its summary (of its seed) and result are there.
     auto finished = [&](int k) {
       const std::string dir = memberDir(k);
